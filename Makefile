@@ -1,0 +1,39 @@
+# Two commands do all set-up on a fresh machine: `make demo` and `make test`.
+VENV     := .venv
+PY       := $(VENV)/bin/python
+STAMP    := $(VENV)/.installed
+# Debian packages the tests and the demo need: Graphviz's dot for graph layout, Chromium for browser tests.
+APT_PKGS := graphviz chromium fonts-dejavu-core
+
+.PHONY: install apt demo test bench clean
+
+install: apt $(STAMP)
+
+$(STAMP): pyproject.toml
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check -e '.[sim,test]'
+	touch $(STAMP)
+
+apt:
+	@missing=""; for p in $(APT_PKGS); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  if [ "$$(id -u)" = 0 ]; then \
+	    echo "installing Debian packages:$$missing"; \
+	    apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends $$missing >/dev/null; \
+	  else \
+	    echo "missing Debian packages:$$missing (run 'sudo make apt' or install them)"; \
+	  fi; \
+	fi
+
+demo: install
+	$(VENV)/bin/fsmscope demo
+
+test: install
+	$(PY) -m pytest -q
+
+bench: install
+	$(PY) bench/runtime.py
+	$(PY) bench/replay.py
+
+clean:
+	rm -rf $(VENV) *.egg-info .pytest_cache

@@ -1,0 +1,65 @@
+"""SMACH's logging hooks.
+
+Every line goes to the bound printer (``set_loggers``) and, when a tool listens, to the
+introspection layer as a ``log`` event. ``_quiet`` lines (start, transition, termination)
+are only printed: the events already say them and ``fsm.transcript`` rebuilds them.
+"""
+
+from typing import Callable
+
+Printer = Callable[[str], object]
+
+_printers: dict[str, Printer] = {
+    "info": lambda m: print("[  INFO ] : " + str(m)),
+    "warn": lambda m: print("[  WARN ] : " + str(m)),
+    "debug": lambda m: print("[ DEBUG ] : " + str(m)),
+    "error": lambda m: print("[ ERROR ] : " + str(m)),
+}
+
+# Set by fsm.introspection while a reporter listens: listener(level, message).
+listener: Callable[[str, str], None] | None = None
+
+
+def _emit(level: str, msg: object) -> None:
+    _printers[level](msg)
+    if listener is not None:
+        listener(level, str(msg))
+
+
+def loginfo(msg: object) -> None:
+    _emit("info", msg)
+
+
+def logwarn(msg: object) -> None:
+    _emit("warn", msg)
+
+
+def logdebug(msg: object) -> None:
+    _emit("debug", msg)
+
+
+def logerr(msg: object) -> None:
+    _emit("error", msg)
+
+
+def info_quiet(msg: str) -> None:
+    """An INFO line that events already carry: printed, not sent as a log event."""
+    _printers["info"](msg)
+
+
+def set_loggers(info: Printer, warn: Printer, debug: Printer, error: Printer) -> None:
+    """Rebind the printers; the order is info, warn, debug, error, as in SMACH."""
+    _printers.update(info=info, warn=warn, debug=debug, error=error)
+
+
+_shutdown_check: Callable[[], bool] = lambda: False
+
+
+def is_shutdown() -> bool:
+    return _shutdown_check()
+
+
+def set_shutdown_check(cb: Callable[[], bool]) -> None:
+    """When ``cb()`` turns True, running containers stop (as with ``rospy.is_shutdown``)."""
+    global _shutdown_check
+    _shutdown_check = cb

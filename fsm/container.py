@@ -1,0 +1,214 @@
+"""What every container shares: construction with ``with``, callbacks, key copying, reporting."""
+
+import threading
+import traceback
+from contextlib import contextmanager
+from typing import Any, Callable, Iterator as TypingIterator
+
+from . import introspection, log
+from .exceptions import InvalidConstructionError, InvalidStateError, InvalidTransitionError
+from .state import State
+from .user_data import UserData
+
+
+class Container(State):
+    """Base of StateMachine, Concurrence and Iterator; holds the children's userdata scope."""
+
+    _construction_stack: list["Container"] = []
+    _construction_lock = threading.RLock()
+    _context_kwargs: list[dict] = []
+
+    def __init__(self, outcomes: Any = [], input_keys: list[str] = [], output_keys: list[str] = []) -> None:
+        State.__init__(self, outcomes, input_keys, output_keys)
+        self.userdata = UserData()
+        self._start_cbs: list[tuple] = []
+        self._transition_cbs: list[tuple] = []
+        self._termination_cbs: list[tuple] = []
+
+    # The interface every container implements.
+    def __getitem__(self, key: str) -> State:
+        raise NotImplementedError()
+
+    def get_children(self) -> dict:
+        raise NotImplementedError()
+
+    def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
+        raise NotImplementedError()
+
+    def get_initial_states(self) -> list[str]:
+        raise NotImplementedError()
+
+    def get_active_states(self) -> list[str]:
+        raise NotImplementedError()
+
+    def get_internal_edges(self) -> list:
+        raise NotImplementedError()
+
+    def check_consistency(self) -> None:
+        raise NotImplementedError()
+
+    def _introspection_info(self) -> dict:
+        """Type-specific fields of this container's structure node."""
+        return {}
+
+    # Userdata passing.
+    def _copy_input_keys(self, parent_ud: Any, ud: UserData) -> None:
+        if parent_ud is not None:
+            for ik in self.get_registered_input_keys():
+                try:
+                    ud[ik] = parent_ud[ik]
+                except KeyError:
+                    log.logwarn("Attempting to copy input key '%s', but this key does not exist." % ik)
+
+    def _copy_output_keys(self, ud: UserData, parent_ud: Any) -> None:
+        if parent_ud is not None:
+            for ok in self.get_registered_output_keys():
+                try:
+                    parent_ud[ok] = ud[ok]
+                except KeyError:
+                    log.logwarn("Attempting to copy output key '%s', but this key does not exist." % ok)
+
+    # Callbacks.
+    def register_start_cb(self, start_cb: Callable, cb_args: list = []) -> None:
+        self._start_cbs.append((start_cb, cb_args))
+
+    def register_transition_cb(self, transition_cb: Callable, cb_args: list = []) -> None:
+        self._transition_cbs.append((transition_cb, cb_args))
+
+    def register_termination_cb(self, termination_cb: Callable, cb_args: list = []) -> None:
+        self._termination_cbs.append((termination_cb, cb_args))
+
+    def call_start_cbs(self) -> None:
+        try:
+            for cb, args in self._start_cbs:
+                cb(self.userdata, self.get_initial_states(), *args)
+        except Exception:
+            log.logerr("Could not execute start callback: " + traceback.format_exc())
+
+    def call_transition_cbs(self) -> None:
+        try:
+            for cb, args in self._transition_cbs:
+                cb(self.userdata, self.get_active_states(), *args)
+        except Exception:
+            log.logerr("Could not execute transition callback: " + traceback.format_exc())
+
+    def call_termination_cbs(self, terminal_states: Any, outcome: Any) -> None:
+        try:
+            for cb, args in self._termination_cbs:
+                cb(self.userdata, terminal_states, outcome, *args)
+        except Exception:
+            log.logerr("Could not execute termination callback: " + traceback.format_exc())
+
+    # Reporting: each a no-op unless a tool observes this machine.
+    def _report_start(self, parent_ud: Any) -> Any:
+        """Run the global hooks for a top-level start; returns the thread context to restore."""
+        if parent_ud is None and introspection._hooks:
+            introspection.on_top_level_start(self)
+        rep = self._reporter
+        if rep is None:
+            return introspection.NOT_ENTERED
+        if rep.root is self:
+            rep.begin_run()
+        return introspection.enter(rep, self._path)
+
+    def _report(self, kind: str, fields: dict) -> None:
+        rep = self._reporter
+        if rep is not None:
+            rep.emit(kind, self._path, fields)
+
+    def _report_changes(self) -> None:
+        rep = self._reporter
+        if rep is not None:
+            changes = introspection.take_changes(self.userdata)
+            if changes:
+                rep.emit("userdata", self._path, {"changes": changes})
+
+    def _report_started(self) -> None:
+        rep = self._reporter
+        if rep is not None:
+            self.userdata._dirty = set()
+            rep.emit("start", self._path, {"initial": [str(s) for s in self.get_initial_states()],
+                                           "active": [str(s) for s in self.get_active_states()],
+                                           "userdata": introspection.userdata_fields(self)})
+
+    def _report_error(self, label: Any, exc: BaseException) -> None:
+        """An ``error`` event from the innermost container that saw ``exc``, then ``terminate``."""
+        rep = self._reporter
+        if rep is None:
+            return
+        if not getattr(exc, "_fsm_reported", False):
+            tb = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
+            rep.emit("error", self._path, introspection.error_fields(label, exc, tb))
+            try:
+                exc._fsm_reported = True
+            except AttributeError:
+                pass
+        rep.emit("terminate", self._path, {"last": [] if label is None else [str(label)], "outcome": None,
+                                           "active": [], "error": "%s: %s" % (type(exc).__name__, exc)})
+
+    def request_preempt(self) -> None:
+        State.request_preempt(self)
+        self._report("preempt", {"phase": "requested"})
+
+    # Construction.
+    def open(self) -> None:
+        Container._construction_stack.append(self)
+        Container._construction_lock.acquire()
+
+    def close(self) -> None:
+        if Container._construction_stack and Container._construction_stack[-1] is not self:
+            raise InvalidStateError("Attempting to close a container that is not currently open.")
+        Container._construction_stack.pop()
+        Container._construction_lock.release()
+        try:
+            self.check_consistency()
+        except (InvalidStateError, InvalidTransitionError):
+            log.logerr("Container consistency check failed.")
+
+    def is_opened(self) -> bool:
+        return bool(Container._construction_stack) and Container._construction_stack[-1] is self
+
+    def assert_opened(self, msg: str = "") -> None:
+        if not self.is_opened():
+            raise InvalidConstructionError(msg)
+
+    @staticmethod
+    def _any_containers_opened() -> bool:
+        return len(Container._construction_stack) > 0
+
+    @classmethod
+    def _currently_opened_container(cls) -> "Container":
+        if Container._any_containers_opened():
+            opened = Container._construction_stack[-1]
+            if not isinstance(opened, cls):
+                raise InvalidStateError("Attempting to call a %s construction method without having opened a %s." % (cls, cls))
+            return opened
+        raise InvalidStateError("Attempting to access the currently opened container, but no container is opened.")
+
+    @contextmanager
+    def opened(self, **kwargs: Any) -> TypingIterator[None]:
+        self.open()
+        prev = Container._context_kwargs
+        Container._context_kwargs = kwargs
+        try:
+            yield
+        finally:
+            Container._context_kwargs = prev
+            self.close()
+
+    def __enter__(self) -> None:
+        return self.open()
+
+    def __exit__(self, exc_type: Any, exc_val: Any, exc_tb: Any) -> bool:
+        if exc_type is None:
+            self.close()
+            return False
+        if exc_type not in (InvalidStateError, InvalidTransitionError):
+            log.logerr("Error raised during SMACH container construction: \n"
+                       + "".join(traceback.format_exception(exc_type, exc_val, exc_tb)))
+        # Fixed against SMACH: the failed container is closed, so the stack and the global lock
+        # are not left held; the exception still propagates.
+        if self in Container._construction_stack:
+            Container._construction_stack.remove(self)
+            Container._construction_lock.release()
+        return False

@@ -1,0 +1,197 @@
+"""Turns a running machine into a stream of events (docs/events.md) for any number of observers.
+
+A machine nobody observes pays one ``is None`` test per step: containers check their
+``_reporter`` attribute, which stays None until ``attach`` binds the tree.
+"""
+
+from __future__ import annotations
+
+import sys
+import threading
+import time
+import traceback
+import uuid
+from typing import Any, Callable
+
+from . import log
+from .encoding import encode_userdata
+
+SCHEMA_VERSION = 1
+DEFAULT_ROOT_PATH = "/SM_ROOT"
+
+Observer = Callable[[dict], None]
+Hook = Callable[[Any], None]
+
+_hooks: list[Hook] = []
+_tls = threading.local()
+_listening: set[Reporter] = set()
+_listening_lock = threading.Lock()
+
+
+class Reporter:
+    """Stamps one machine's events (seq, time, run) and hands them to its observers in order."""
+
+    def __init__(self, root: Any, machine: str, root_path: str = DEFAULT_ROOT_PATH) -> None:
+        self.root = root
+        self.machine = machine
+        self.root_path = root_path
+        self.run: str | None = None
+        self._seq = 0
+        self._observers: list[Observer] = []
+        self._lock = threading.RLock()
+        self._emitting = False
+
+    @property
+    def last_seq(self) -> int:
+        return self._seq
+
+    def add_observer(self, observer: Observer) -> None:
+        with self._lock:
+            self._observers = self._observers + [observer]
+        _set_listening(self, True)
+
+    def remove_observer(self, observer: Observer) -> None:
+        with self._lock:
+            self._observers = [o for o in self._observers if o is not observer]
+            empty = not self._observers
+        if empty:
+            _set_listening(self, False)
+
+    def emit(self, kind: str, path: str | None, fields: dict | None = None) -> dict | None:
+        """Stamp and deliver one event; returns it (None when nobody listens)."""
+        if not self._observers:
+            return None
+        with self._lock:
+            if self._emitting:  # an observer logged: do not recurse into ourselves
+                return None
+            self._seq += 1
+            event = {"v": SCHEMA_VERSION, "seq": self._seq, "t": time.time(), "run": self.run,
+                     "machine": self.machine, "kind": kind, "path": path}
+            if fields:
+                event.update(fields)
+            self._emitting = True
+            try:
+                for observer in self._observers:
+                    try:
+                        observer(event)
+                    except Exception:
+                        sys.stderr.write("fsm: an observer failed:\n" + traceback.format_exc())
+            finally:
+                self._emitting = False
+        return event
+
+    def begin_run(self) -> None:
+        """Called by the root container as it starts: a new run id, then the structure."""
+        self.run = uuid.uuid4().hex[:12]
+        self.emit("structure", self.root_path, {"root": self.structure()})
+
+    def structure(self) -> dict:
+        """Bind every state of the tree to this reporter and describe the tree (docs/events.md)."""
+        label = self.root_path.rstrip("/").rsplit("/", 1)[-1] or "SM_ROOT"
+        return _describe(self.root, label, self.root_path, self, {})
+
+
+def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict) -> dict:
+    state._reporter = rep
+    state._path = path
+    node = {"label": label, "path": path, "type": type(state).__name__,
+            "container": hasattr(state, "get_children"),
+            "outcomes": sorted(map(str, state.get_registered_outcomes())),
+            "input_keys": sorted(map(str, state.get_registered_input_keys())),
+            "output_keys": sorted(map(str, state.get_registered_output_keys())),
+            "remapping": {str(k): str(v) for k, v in (remapping or {}).items()}}
+    if not node["container"]:
+        return node
+    if state.userdata._dirty is None:
+        state.userdata._dirty = set()
+    remappings = getattr(state, "_remappings", {})
+    node["initial"] = [str(s) for s in state.get_initial_states()]
+    node["children"] = [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
+                        for lbl, child in state.get_children().items()]
+    node["transitions"] = [{"from": str(frm), "outcome": str(outcome), "to": None if to is None else str(to)}
+                           for outcome, frm, to in state.get_internal_edges()]
+    node.update(state._introspection_info())
+    return node
+
+
+def attach(machine: Any, observer: Observer | None = None, name: str | None = None,
+           path: str = DEFAULT_ROOT_PATH) -> Reporter:
+    """Observe a top-level container; a second call adds an observer to the same reporter."""
+    rep = machine.__dict__.get("_reporter")
+    if rep is None or rep.root is not machine:
+        rep = Reporter(machine, name or path.rsplit("/", 1)[-1] or "SM_ROOT", path)
+        machine._reporter = rep
+        machine._path = path
+        rep.structure()
+    if observer is not None:
+        rep.add_observer(observer)
+    return rep
+
+
+def reporter_of(machine: Any) -> Reporter | None:
+    rep = machine.__dict__.get("_reporter")
+    return rep if rep is not None and rep.root is machine else None
+
+
+def add_global_hook(hook: Hook) -> None:
+    """``hook(container)`` runs whenever a top-level container starts executing, before its first event."""
+    _hooks.append(hook)
+
+
+def remove_global_hook(hook: Hook) -> None:
+    if hook in _hooks:
+        _hooks.remove(hook)
+
+
+def on_top_level_start(container: Any) -> None:
+    for hook in list(_hooks):
+        try:
+            hook(container)
+        except Exception:
+            sys.stderr.write("fsm: a global introspection hook failed:\n" + traceback.format_exc())
+
+
+NOT_ENTERED = object()
+
+
+def enter(rep: Reporter, path: str) -> Any:
+    """Mark ``path`` as the innermost observed container running on this thread (for log events)."""
+    prev = getattr(_tls, "ctx", None)
+    _tls.ctx = (rep, path)
+    return prev
+
+
+def leave(prev: Any) -> None:
+    if prev is not NOT_ENTERED:
+        _tls.ctx = prev
+
+
+def _on_log(level: str, msg: str) -> None:
+    ctx = getattr(_tls, "ctx", None)
+    if ctx is not None:
+        ctx[0].emit("log", ctx[1], {"level": level, "msg": msg})
+
+
+def _set_listening(rep: Reporter, on: bool) -> None:
+    with _listening_lock:
+        (_listening.add if on else _listening.discard)(rep)
+        log.listener = _on_log if _listening else None
+
+
+def userdata_fields(container: Any) -> dict:
+    return encode_userdata(container.userdata._data)
+
+
+def take_changes(userdata: Any) -> dict | None:
+    """Encode the keys written since the last call, or None when nothing was written."""
+    dirty = userdata._dirty
+    if not dirty:
+        return None
+    userdata._dirty = set()
+    data = userdata._data
+    return encode_userdata({k: data[k] for k in dirty if k in data})
+
+
+def error_fields(state_label: Any, exc: BaseException, tb: str) -> dict:
+    return {"state": None if state_label is None else str(state_label), "exc_type": type(exc).__name__,
+            "message": str(exc), "traceback": tb}

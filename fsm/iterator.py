@@ -1,0 +1,156 @@
+"""Iterator: runs one contained state once per item, until the items run out or an outcome breaks."""
+
+import traceback
+from typing import Any, Callable, Iterable
+
+from . import introspection, log
+from .container import Container
+from .exceptions import InvalidUserCodeError
+from .state import State
+
+
+class Iterator(Container):
+    def __init__(self, outcomes: list[str], input_keys: list[str], output_keys: list[str],
+                 it: Iterable | Callable[[], Iterable] = [], it_label: str = "it_data",
+                 exhausted_outcome: str = "exhausted") -> None:
+        if exhausted_outcome not in outcomes:
+            outcomes.append(exhausted_outcome)
+        Container.__init__(self, outcomes, input_keys, output_keys)
+        self._items = it
+        self._items_label = it_label
+        self._is_running = False
+        self._state_label: Any = ""
+        self._state: State | None = None
+        self._loop_outcomes: list[str] = []
+        self._break_outcomes: list[str] = []
+        self._final_outcome_map: dict = {}
+        self._exhausted_outcome = exhausted_outcome
+
+    @staticmethod
+    def set_iteritems(it: Iterable | Callable[[], Iterable], it_label: str = "it_data") -> None:
+        self = Iterator._currently_opened_container()
+        self._items = it
+        self._items_label = it_label
+
+    @staticmethod
+    def set_contained_state(label: str, state: State, loop_outcomes: list[str] = [], break_outcomes: list[str] = [],
+                            final_outcome_map: dict = {}) -> State:
+        """Outcomes not listed as loop (or break) outcomes do the opposite."""
+        self = Iterator._currently_opened_container()
+        if loop_outcomes and break_outcomes:
+            log.logwarn("Both loop_outcomes and break_outcomes were specified when constructing SMACH iterator container.")
+        outcomes = state.get_registered_outcomes()
+        if break_outcomes:
+            break_outcomes = list(break_outcomes)
+            loop_outcomes = list(loop_outcomes) + [o for o in outcomes if o not in break_outcomes and o not in loop_outcomes]
+        else:
+            loop_outcomes = list(loop_outcomes)
+            break_outcomes = [o for o in outcomes if o not in loop_outcomes]
+        self._loop_outcomes = loop_outcomes
+        self._break_outcomes = break_outcomes
+        self._final_outcome_map = final_outcome_map
+        self._state = state
+        self._state_label = label
+        return state
+
+    def execute(self, parent_ud: Any = None) -> Any:
+        ctx = self._report_start(parent_ud)
+        try:
+            return self._execute(parent_ud)
+        except BaseException as exc:
+            self._is_running = False
+            self._report_error(self._state_label, exc)
+            raise
+        finally:
+            introspection.leave(ctx)
+
+    def _execute(self, parent_ud: Any) -> Any:
+        self._is_running = True
+        self._copy_input_keys(parent_ud, self.userdata)
+        self._report_started()
+        self.call_start_cbs()
+        items = self._items
+        it = iter(items() if callable(items) else items)
+        outcome = self._exhausted_outcome
+        state_outcome = None
+        rep = self._reporter
+        while not log.is_shutdown():
+            try:
+                item = next(it)
+            except Exception:  # any failure of the iterable counts as exhaustion, as in SMACH
+                break
+            log.loginfo("Iterating %s of %s" % (str(item), str(items)))
+            self.userdata[self._items_label] = item
+            try:
+                state_outcome = self._state.execute(self.userdata)
+            except InvalidUserCodeError:
+                raise
+            except Exception:
+                raise InvalidUserCodeError("Could not execute iterator state '%s' of type '%s': "
+                                           % (self._state_label, self._state) + traceback.format_exc())
+            if rep is not None:
+                self._report_changes()
+            if self._preempt_requested:
+                self.service_preempt()
+                outcome = self._final_outcome_map.get(state_outcome, state_outcome)
+                break
+            if state_outcome in self._break_outcomes or (self._loop_outcomes and state_outcome not in self._loop_outcomes):
+                outcome = self._final_outcome_map.get(state_outcome, state_outcome)
+                break
+            if rep is not None:
+                rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(state_outcome),
+                                                    "to": str(self._state_label), "active": [str(self._state_label)]})
+            self.call_transition_cbs()
+        self._copy_output_keys(self.userdata, parent_ud)
+        self._is_running = False
+        self._report("terminate", {"last": [str(self._state_label)], "outcome": None if outcome is None else str(outcome),
+                                   "active": []})
+        self.call_termination_cbs(self._state_label, outcome)
+        return outcome
+
+    def request_preempt(self) -> None:
+        State.request_preempt(self)
+        self._report("preempt", {"phase": "requested"})
+        if self._is_running and self._state is not None:
+            self._state.request_preempt()
+
+    def get_children(self) -> dict:
+        return {self._state_label: self._state} if self._state is not None else {}
+
+    def __getitem__(self, key: str) -> State:
+        if key != self._state_label:
+            log.logerr("Attempting to get state '%s' from Iterator container. The only available state is '%s'."
+                       % (key, self._state_label))
+            raise KeyError()
+        return self._state
+
+    def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
+        """Fixed against SMACH (a TypeError for several states): takes the first, merges the userdata."""
+        if len(initial_states) > 1:
+            log.logwarn("Attempting to set initial state to include more than one state, but the Iterator container can only have one initial state. Taking the first one.")
+        if initial_states and initial_states[0] != self._state_label:
+            log.logwarn("Attempting to set initial state of Iterator to '%s', but its only state is '%s'."
+                        % (initial_states[0], self._state_label))
+            raise KeyError()
+        if userdata is not None:
+            self.userdata.update(userdata)
+
+    def get_initial_states(self) -> list[str]:
+        return [str(self._state_label)]
+
+    def get_active_states(self) -> list[str]:
+        return [str(self._state_label)] if self._is_running else []
+
+    def get_internal_edges(self) -> list:
+        edges: list = [[o, self._state_label, self._state_label] for o in self._loop_outcomes]
+        edges += [(o, self._state_label, self._final_outcome_map.get(o)) for o in self._break_outcomes]
+        return edges
+
+    def _introspection_info(self) -> dict:
+        return {"exhausted_outcome": self._exhausted_outcome}
+
+    def check_consistency(self) -> None:
+        pass
+
+    def is_running(self) -> bool:
+        return self._is_running

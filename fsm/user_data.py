@@ -1,0 +1,161 @@
+"""Userdata: a container's key/value scope, and the Remapper through which a child sees it."""
+
+from typing import Any, Iterable, Mapping
+
+from . import log
+from .exceptions import InvalidUserCodeError
+
+
+class UserData:
+    """A container's local data. A missing key logs an error and raises a bare KeyError (as SMACH)."""
+
+    def __init__(self) -> None:
+        object.__setattr__(self, "_data", {})
+        # Keys written since the last userdata event; a set only while a reporter listens.
+        object.__setattr__(self, "_dirty", None)
+
+    def __getattr__(self, name: str) -> Any:
+        if name[0] == "_":
+            raise AttributeError(name)
+        try:
+            return self._data[name]
+        except KeyError:
+            log.logerr("Userdata key '%s' not available. Available keys are: %s" % (name, list(self._data.keys())))
+            raise KeyError() from None
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name[0] == "_":
+            object.__setattr__(self, name, value)
+            return
+        self._data[name] = value
+        dirty = self._dirty
+        if dirty is not None:
+            dirty.add(name)
+
+    __getitem__ = __getattr__
+    __setitem__ = __setattr__
+
+    def keys(self) -> list[str]:
+        return list(self._data.keys())
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._data
+
+    def update(self, other: "UserData | Mapping[str, Any]") -> None:
+        """Merge another UserData (or, beyond SMACH, a plain mapping) into this one."""
+        items = other._data if isinstance(other, UserData) else other
+        for key, value in dict(items).items():
+            self[key] = value
+
+    def extract(self, keys: Iterable[str], remapping: Mapping[str, str]) -> "UserData":
+        ud = UserData()
+        reverse = {}
+        for k, v in remapping.items():
+            reverse.setdefault(v, []).append(k)
+        for v, ks in reverse.items():
+            if len(ks) > 1:
+                log.logerr("SMACH userdata remapping is not one-to-one: " + str(reverse))
+                break
+        for k in keys:
+            rmk = remapping.get(k, k)
+            ud[rmk] = self[k]
+        return ud
+
+    def merge(self, ud: "UserData", keys: Iterable[str], remapping: Mapping[str, str]) -> None:
+        for k in keys:
+            rmk = remapping.get(k, k)
+            self[rmk] = ud[k]
+
+    def __str__(self) -> str:
+        return str(self._data)
+
+
+class Const:
+    """Read-only view of an input-only value that has a ``__dict__``.
+
+    Fixed against SMACH: setting an attribute raises (SMACH's guard never fired), and
+    methods of the wrapped object can be called (SMACH wrapped them uncallable).
+    """
+
+    def __init__(self, obj: Any) -> None:
+        log.logdebug("Making const '%s'" % str(obj))
+        object.__setattr__(self, "_obj", obj)
+
+    def __getattr__(self, name: str) -> Any:
+        log.logdebug("Getting '%s' from const wrapper." % name)
+        return get_const(getattr(self._obj, name))
+
+    def __getitem__(self, name: Any) -> Any:
+        log.logdebug("Getting '%s' from const wrapper." % name)
+        return get_const(self._obj[name])
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        log.logerr("Attempting to set '%s' but this member is read-only." % name)
+        raise TypeError()
+
+    def __delattr__(self, name: str) -> None:
+        log.logerr("Attempting to delete '%s' but this member is read-only." % name)
+        raise TypeError()
+
+    def __repr__(self) -> str:
+        return repr(self._obj)
+
+    def __str__(self) -> str:
+        return str(self._obj)
+
+
+def get_const(obj: Any) -> Any:
+    """Wrap objects with a ``__dict__``; callables are returned as they are so they can run."""
+    if hasattr(obj, "__dict__") and not callable(obj):
+        return Const(obj)
+    return obj
+
+
+class Remapper:
+    """What a child state sees: only its declared keys, under its local names."""
+
+    __slots__ = ("_ud", "_input", "_output", "_remapping")
+
+    def __init__(self, ud: Any, input_keys: Iterable[str] = (), output_keys: Iterable[str] = (),
+                 remapping: Mapping[str, str] | None = None) -> None:
+        object.__setattr__(self, "_ud", ud)
+        object.__setattr__(self, "_input", frozenset(input_keys))
+        object.__setattr__(self, "_output", frozenset(output_keys))
+        object.__setattr__(self, "_remapping", remapping or {})
+
+    def _remap(self, key: str) -> str:
+        return self._remapping.get(key, key)
+
+    def __getattr__(self, name: str) -> Any:
+        if name[0] == "_":
+            raise AttributeError(name)
+        if name not in self._input:
+            raise InvalidUserCodeError(
+                "Reading from SMACH userdata key '%s' but the only keys that were declared as input to this state were: %s. "
+                "This key needs to be declared as input to this state. " % (name, tuple(self._input)))
+        if name not in self._output:
+            return get_const(self._ud[self._remapping.get(name, name)])
+        return self._ud[self._remapping.get(name, name)]
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        if name[0] == "_":
+            object.__setattr__(self, name, value)
+            return
+        if name not in self._output:
+            log.logerr("Writing to SMACH userdata key '%s' but the only keys that were declared as output from this state were: %s."
+                       % (name, tuple(self._output)))
+            return
+        self._ud[self._remapping.get(name, name)] = value
+
+    __getitem__ = __getattr__
+    __setitem__ = __setattr__
+
+    def keys(self) -> list[str]:
+        """The local names of the declared input keys present in the parent (fixed: SMACH mixed up the names)."""
+        return [k for k in self._input if self._remap(k) in self._ud]
+
+    def __contains__(self, key: str) -> bool:
+        return key in self._input and self._remap(key) in self._ud
+
+    def update(self, other: Any) -> None:
+        self._ud.update(other)

@@ -1,0 +1,121 @@
+"""The state of one machine, rebuilt from its events: what a snapshot holds and a viewer shows.
+
+One reducer serves the recorder's snapshots, replay and the server's hub, so that a
+replayed run and a live one cannot disagree.
+"""
+
+from __future__ import annotations
+
+import copy
+from typing import Any, Iterator
+
+
+def _container_entry(initial: list[str] | None = None) -> dict:
+    return {"active": [], "initial": list(initial or []), "userdata": {}, "running": False, "outcome": None}
+
+
+def _containers(node: dict) -> Iterator[dict]:
+    if node.get("container"):
+        yield node
+        for child in node.get("children", ()):
+            yield from _containers(child)
+
+
+class Status:
+    """Per machine: structure, and per container path its active/initial states, userdata, outcome."""
+
+    def __init__(self, machine: str) -> None:
+        self.machine = machine
+        self.run: str | None = None
+        self.root_path: str | None = None
+        self.structure: dict | None = None
+        self.containers: dict[str, dict] = {}
+        self.running = False
+        self.outcome: str | None = None
+        self.error: dict | None = None
+        self.last_seq = 0
+        self.last_t: float | None = None
+
+    def apply(self, event: dict) -> None:
+        kind = event["kind"]
+        path = event["path"]
+        self.last_seq = event["seq"]
+        self.last_t = event.get("t")
+        self.run = event.get("run", self.run)
+        if kind == "snapshot":
+            self._load(event["status"])
+            return
+        if kind == "structure":
+            self._set_structure(path, event["root"])
+            return
+        if kind not in ("start", "transition", "userdata", "terminate", "error"):
+            return
+        entry = self.containers.get(path)
+        if entry is None:
+            entry = self.containers[path] = _container_entry()
+        root = path == self.root_path
+        if kind == "start":
+            entry.update(active=list(event["active"]), initial=list(event["initial"]),
+                         userdata=dict(event["userdata"]), running=True, outcome=None)
+            if root:
+                self.running, self.outcome, self.error = True, None, None
+        elif kind == "transition":
+            entry["active"] = list(event["active"])
+        elif kind == "userdata":
+            entry["userdata"].update(event["changes"])
+        elif kind == "terminate":
+            entry.update(active=[], running=False, outcome=event["outcome"])
+            if root:
+                self.running, self.outcome = False, event["outcome"]
+                if event.get("error") and self.error is None:
+                    self.error = {"path": path, "message": event["error"]}
+        elif kind == "error":
+            self.error = {k: event.get(k) for k in ("path", "state", "exc_type", "message", "traceback")}
+
+    def _set_structure(self, path: str, root: dict) -> None:
+        self.root_path = path
+        self.structure = root
+        previous = self.containers
+        self.containers = {}
+        for node in _containers(root):
+            entry = previous.get(node["path"]) or _container_entry()
+            entry["initial"] = list(node.get("initial", []))
+            self.containers[node["path"]] = entry
+
+    def active_paths(self) -> list[str]:
+        """Every active state's full path, at every level."""
+        return [p + "/" + label for p, c in self.containers.items() for label in c["active"] if label != "None"]
+
+    def to_dict(self) -> dict:
+        return {"machine": self.machine, "run": self.run, "root_path": self.root_path, "structure": self.structure,
+                "containers": copy.deepcopy(self.containers), "running": self.running, "outcome": self.outcome,
+                "error": self.error, "last_seq": self.last_seq, "last_t": self.last_t}
+
+    def _load(self, data: dict) -> None:
+        self.run = data.get("run")
+        self.root_path = data.get("root_path")
+        self.structure = data.get("structure")
+        self.containers = copy.deepcopy(data.get("containers") or {})
+        self.running = bool(data.get("running"))
+        self.outcome = data.get("outcome")
+        self.error = data.get("error")
+        self.last_seq = data.get("last_seq", self.last_seq)
+        self.last_t = data.get("last_t", self.last_t)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> Status:
+        status = cls(data["machine"])
+        status._load(data)
+        return status
+
+
+def rebuild(events: Any) -> dict[str, Status]:
+    """Apply a stream of events of any number of machines; returns one Status per machine."""
+    statuses: dict[str, Status] = {}
+    for event in events:
+        machine = event["machine"]
+        status = statuses.get(machine)
+        if status is None:
+            status = statuses[machine] = Status(machine)
+        status.apply(event)
+    return statuses

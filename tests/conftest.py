@@ -1,0 +1,50 @@
+"""Shared fixtures: captured log lines, and the runtime's globals restored after every test."""
+
+import fsm
+import fsm.log
+import pytest
+from fsm.container import Container
+
+
+class Logs:
+    """Log lines passed to the four printers, per level and in one ordered list."""
+
+    def __init__(self) -> None:
+        self.info: list[str] = []
+        self.warn: list[str] = []
+        self.debug: list[str] = []
+        self.error: list[str] = []
+        self.all: list[tuple[str, str]] = []
+
+    def _printer(self, level: str):
+        lines = getattr(self, level)
+
+        def printer(msg: object) -> None:
+            lines.append(str(msg))
+            self.all.append((level, str(msg)))
+        return printer
+
+    def install(self) -> None:
+        fsm.set_loggers(self._printer("info"), self._printer("warn"), self._printer("debug"), self._printer("error"))
+
+
+@pytest.fixture(autouse=True)
+def _restore_runtime_globals():
+    """Put back the default printers and shutdown check, and fail a test that leaves a container open."""
+    printers = dict(fsm.log._printers)
+    shutdown_check = fsm.log._shutdown_check
+    yield
+    fsm.log._printers.clear()
+    fsm.log._printers.update(printers)
+    fsm.log._shutdown_check = shutdown_check
+    left_open = list(Container._construction_stack)
+    Container._construction_stack.clear()
+    assert not left_open, "a test left containers open: %r" % left_open
+
+
+@pytest.fixture
+def logs() -> Logs:
+    """Capture every log line into lists (restored to the default printers afterwards)."""
+    captured = Logs()
+    captured.install()
+    return captured

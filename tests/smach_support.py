@@ -1,0 +1,89 @@
+"""Small states and builders shared by the SMACH acceptance tests (``import fsm as smach``)."""
+
+import threading
+from typing import Any, Callable
+
+import fsm as smach
+
+
+class Out(smach.State):
+    """Returns ``result`` (or ``result(ud)`` if callable) and counts its executions."""
+
+    def __init__(self, result: Any = "done", outcomes: Any = None, input_keys: list = [],
+                 output_keys: list = [], io_keys: list = []) -> None:
+        smach.State.__init__(self, outcomes if outcomes is not None else [result], input_keys, output_keys, io_keys)
+        self.result = result
+        self.runs = 0
+        self.saw_preempt: list[bool] = []
+
+    def execute(self, ud: Any) -> Any:
+        self.runs += 1
+        self.saw_preempt.append(self.preempt_requested())
+        return self.result(ud) if callable(self.result) else self.result
+
+
+class WaitForPreempt(smach.State):
+    """Blocks until preempted (``started`` is set once it runs); services the preempt if told to."""
+
+    def __init__(self, outcomes: Any = ("preempted",), service: bool = True, result: str = "preempted",
+                 timeout: float = 5.0) -> None:
+        smach.State.__init__(self, list(outcomes))
+        self.started = threading.Event()
+        self._preempt_event = threading.Event()
+        self.service = service
+        self.result = result
+        self.timeout = timeout
+
+    def request_preempt(self) -> None:
+        smach.State.request_preempt(self)
+        self._preempt_event.set()
+
+    def execute(self, ud: Any) -> str:
+        self.started.set()
+        if not self._preempt_event.wait(self.timeout):
+            return "timeout"
+        self._preempt_event.clear()
+        if self.service:
+            self.service_preempt()
+        return self.result
+
+
+def machine(outcomes: list, children: list, **kwargs: Any) -> smach.StateMachine:
+    """A StateMachine built from ``(label, state, transitions[, remapping])`` tuples."""
+    sm = smach.StateMachine(outcomes=outcomes, **kwargs)
+    with sm:
+        for child in children:
+            smach.StateMachine.add(*child)
+    return sm
+
+
+def concurrence(outcomes: list, default_outcome: str, children: list, **kwargs: Any) -> smach.Concurrence:
+    """A Concurrence built from ``(label, state[, remapping])`` tuples."""
+    cc = smach.Concurrence(outcomes=outcomes, default_outcome=default_outcome, **kwargs)
+    with cc:
+        for child in children:
+            smach.Concurrence.add(*child)
+    return cc
+
+
+class Background:
+    """Runs ``fn()`` in a thread; ``join()`` returns its result or re-raises its exception."""
+
+    def __init__(self, fn: Callable[[], Any]) -> None:
+        self.result: Any = None
+        self.error: BaseException | None = None
+        self._thread = threading.Thread(target=self._run, args=(fn,), daemon=True)
+        self._thread.start()
+
+    def _run(self, fn: Callable[[], Any]) -> None:
+        try:
+            self.result = fn()
+        except BaseException as exc:  # handed to the test thread
+            self.error = exc
+
+    def join(self, timeout: float = 5.0) -> Any:
+        self._thread.join(timeout)
+        assert not self._thread.is_alive(), "background execution did not finish"
+        if self.error is not None:
+            raise self.error
+        return self.result

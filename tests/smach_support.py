@@ -7,11 +7,13 @@ import fsm as smach
 
 
 class Out(smach.State):
-    """Returns ``result`` (or ``result(ud)`` if callable) and counts its executions."""
+    """Returns ``result`` (or ``result(ud)`` if callable: outcomes then default to ``["done"]``); counts its runs."""
 
     def __init__(self, result: Any = "done", outcomes: Any = None, input_keys: list = [],
                  output_keys: list = [], io_keys: list = []) -> None:
-        smach.State.__init__(self, outcomes if outcomes is not None else [result], input_keys, output_keys, io_keys)
+        if outcomes is None:
+            outcomes = ["done"] if callable(result) else [result]
+        smach.State.__init__(self, outcomes, input_keys, output_keys, io_keys)
         self.result = result
         self.runs = 0
         self.saw_preempt: list[bool] = []

@@ -1,8 +1,9 @@
 """Concurrence: every child runs at once; the outcome comes from an outcome map, a callback or a default.
 
-Children run on long-lived pool threads (the first one in the caller's thread). A preempt,
-a child's error, or a truthy ``child_termination_cb`` preempts the unfinished children at
-once from the thread that caused it, so the caller only waits for the last child.
+Each child is offered to a long-lived pool thread; the caller, meanwhile, runs every child no
+worker has claimed yet, so quick children never wait for a thread to wake and a blocking child
+still gets a thread of its own. A preempt, a child's error, or a truthy ``child_termination_cb``
+preempts the unfinished children at once from the thread that caused it.
 """
 
 import copy
@@ -85,9 +86,11 @@ class Concurrence(Container):
             for state in states.values():
                 state.request_preempt()
         items = list(states.items())
-        for label, state in items[1:]:
-            pool.submit(self._run_child, label, state)
+        jobs = [pool.submit(self._run_child, label, state) for label, state in items[1:]]
         self._run_child(*items[0])
+        for job, (label, state) in zip(jobs, items[1:]):
+            if pool.take(job):
+                self._run_child(label, state)
         with self._done_cond:
             while self._pending and not log.is_shutdown():
                 self._done_cond.wait(0.1)

@@ -11,6 +11,8 @@ import threading
 import time
 import traceback
 import uuid
+from threading import get_ident
+from time import time as _now
 from typing import Any, Callable
 
 from . import log
@@ -38,46 +40,44 @@ class Reporter:
         self.run: str | None = None
         self._seq = 0
         self._observers: list[Observer] = []
-        self._lock = threading.RLock()
-        self._emitting = False
+        self._lock = threading.Lock()
+        self._owner: int | None = None  # the thread delivering an event right now
 
     @property
     def last_seq(self) -> int:
         return self._seq
 
     def add_observer(self, observer: Observer) -> None:
-        with self._lock:
-            self._observers = self._observers + [observer]
+        # Replaced, never mutated: emit iterates the list it read without the lock.
+        self._observers = self._observers + [observer]
         _set_listening(self, True)
 
     def remove_observer(self, observer: Observer) -> None:
-        with self._lock:
-            self._observers = [o for o in self._observers if o is not observer]
-            empty = not self._observers
-        if empty:
+        self._observers = [o for o in self._observers if o is not observer]
+        if not self._observers:
             _set_listening(self, False)
 
     def emit(self, kind: str, path: str | None, fields: dict | None = None) -> dict | None:
         """Stamp and deliver one event; returns it (None when nobody listens)."""
-        if not self._observers:
+        observers = self._observers
+        if not observers:
+            return None
+        me = get_ident()
+        if self._owner == me:  # an observer logged: do not recurse into ourselves
             return None
         with self._lock:
-            if self._emitting:  # an observer logged: do not recurse into ourselves
-                return None
-            self._seq += 1
-            event = {"v": SCHEMA_VERSION, "seq": self._seq, "t": time.time(), "run": self.run,
+            self._owner = me
+            self._seq = seq = self._seq + 1
+            event = {"v": SCHEMA_VERSION, "seq": seq, "t": _now(), "run": self.run,
                      "machine": self.machine, "kind": kind, "path": path}
             if fields:
                 event.update(fields)
-            self._emitting = True
-            try:
-                for observer in self._observers:
-                    try:
-                        observer(event)
-                    except Exception:
-                        sys.stderr.write("fsm: an observer failed:\n" + traceback.format_exc())
-            finally:
-                self._emitting = False
+            for observer in observers:
+                try:
+                    observer(event)
+                except Exception:
+                    sys.stderr.write("fsm: an observer failed:\n" + traceback.format_exc())
+            self._owner = None
         return event
 
     def begin_run(self) -> None:

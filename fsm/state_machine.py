@@ -142,7 +142,7 @@ class StateMachine(Container):
                                          % (str(outcome), str(last_state_label), str(transitions)))
         target = transitions[outcome]
         rep = self._reporter
-        if rep is not None:
+        if rep is not None and self.userdata._dirty:
             self._report_changes()
 
         if target in self._states:

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 import threading
 import time
+from collections import deque
 from dataclasses import dataclass
 from importlib import resources
 
@@ -88,7 +89,8 @@ class World:
         self._stop = False
         self._waiting: list[float] = []  # simulated times waiters wait for (fast mode)
         self._path: JointPath | None = None
-        self.label = ""  # the task machine's current state, drawn by the scene
+        self._label = ""
+        self.labels: deque[tuple[float, str]] = deque(maxlen=256)  # (sim time, label) history
         self.steps = 0
         m = self.model
         self.arm_qadr = np.array([m.jnt_qposadr[m.joint(n).id] for n in ARM_JOINTS])
@@ -109,6 +111,16 @@ class World:
         self._cube_inertia0 = m.body_inertia[self.cube_body].copy()
         self.seed = seed
         self.reset(seed)
+
+    @property
+    def label(self) -> str:
+        """The task machine's current state, as the scene draws it."""
+        return self._label
+
+    @label.setter
+    def label(self, text: str) -> None:
+        self._label = text
+        self.labels.append((float(self.data.time), text))
 
     # ------------------------------------------------------------------ episodes
     def reset(self, seed: int | None = None) -> dict:

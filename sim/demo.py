@@ -1,0 +1,226 @@
+"""``fsmscope demo``: the pick-and-place machine running episodes on the simulated arm.
+
+For embedding (the dashboard, the recorder)::
+
+    if not args.verbose:
+        import fsm
+
+        def quiet(msg):
+            pass
+
+        fsm.set_loggers(quiet, lambda m: print("[ WARN ] " + str(m), file=sys.stderr), quiet,
+                        lambda m: print("[ ERROR ] " + str(m), file=sys.stderr))
+    demo = SimDemo(seed=0, fast=False, bus=None, scene=True)   # world, servers, 3D view
+    print(demo.scene.url)                                      # viser on 127.0.0.1
+    results = demo.run(episodes=5, on_episode=print)            # blocks; one machine per episode
+    demo.request_stop()                                         # from any thread: preempt + end loop
+    demo.close()                                                # threads joined, ports freed
+
+or the pieces: ``World(seed, fast).start()``, ``start_servers(world, bus)``,
+``build_task_machine(world, bus)``, ``start_scene(world)``, ``run_episodes(...)``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import threading
+import time
+from typing import Any, Callable
+
+from .world import World
+
+Machine = Any
+
+
+def run_episodes(world: World, machine_factory: Callable[[World], Machine], episodes: int,
+                 on_episode: Callable[[dict], Any] | None = None, *, seed: int | None = None,
+                 pause: float = 1.0, stop: threading.Event | None = None,
+                 on_machine: Callable[[int, Machine], Any] | None = None,
+                 continue_after_preempt: bool = False) -> list[dict]:
+    """Run ``episodes`` episodes (0: until ``stop`` is set); a list of per-episode dicts.
+
+    Each episode resets the world with seed ``seed + i`` (the cube at a seeded random
+    place, the arm at HOME), builds a fresh machine with ``machine_factory(world)``,
+    hands it to ``on_machine(i, machine)`` (to attach a dashboard or keep it for
+    preemption), executes it, then calls ``on_episode(info)``. A 'preempted' episode
+    ends the loop unless ``continue_after_preempt``. ``pause`` is simulated seconds
+    between episodes (with the arm holding still).
+    """
+    base = world.seed if seed is None else seed
+    results: list[dict] = []
+    i = 0
+    while episodes <= 0 or i < episodes:
+        if stop is not None and stop.is_set():
+            break
+        ep_seed = base + i
+        world.reset(ep_seed)
+        world.label = "starting"
+        machine = machine_factory(world)
+        if on_machine is not None:
+            on_machine(i, machine)
+        if stop is not None and stop.is_set():
+            break
+        t_wall, t_sim = time.perf_counter(), world.time
+        outcome = machine.execute()
+        if outcome == "preempted":
+            world.hold()
+        ud = getattr(machine, "userdata", None)
+        info = {
+            "episode": i,
+            "seed": ep_seed,
+            "outcome": outcome,
+            "cube_target_distance": world.cube_target_distance(),
+            "attempts": getattr(ud, "attempts", None) if ud is not None else None,
+            "sim_time": world.time - t_sim,
+            "wall_time": time.perf_counter() - t_wall,
+        }
+        world.label = f"episode {i}: {outcome}"
+        results.append(info)
+        if on_episode is not None:
+            on_episode(info)
+        i += 1
+        if outcome == "preempted" and not continue_after_preempt:
+            break
+        if pause > 0 and (stop is None or not stop.is_set()):
+            try:
+                world.sleep(pause)
+            except Exception:
+                break
+    return results
+
+
+class SimDemo:
+    """World + action servers (+ 3D view) wired together; ``close()`` undoes all of it."""
+
+    def __init__(self, seed: int = 0, fast: bool = False, bus=None, scene: bool = True,
+                 host: str = "127.0.0.1", port: int = 0, speed: float = 1.0):
+        from fsm.bus import get_bus
+
+        from .servers import start_servers
+
+        self.bus = get_bus(bus)
+        self.world = World(seed=seed, fast=fast, speed=speed).start()
+        self.move_to, self.gripper = start_servers(self.world, self.bus)
+        self.scene = None
+        if scene:
+            from .scene import start_scene
+
+            self.scene = start_scene(self.world, host=host, port=port)
+        self.stop_event = threading.Event()
+        self.machine: Machine | None = None
+        self._closed = False
+
+    def build_machine(self, world: World | None = None) -> Machine:
+        from .task import build_task_machine
+
+        return build_task_machine(world or self.world, bus=self.bus)
+
+    def _keep(self, i: int, machine: Machine) -> None:
+        self.machine = machine
+
+    def run(self, episodes: int = 0, on_episode=None, *, seed: int | None = None,
+            pause: float | None = None, machine_factory=None, on_machine=None) -> list[dict]:
+        """Run episodes in the calling thread (see :func:`run_episodes`)."""
+        def keep(i, m):
+            self._keep(i, m)
+            if on_machine is not None:
+                on_machine(i, m)
+
+        if pause is None:
+            pause = 0.0 if self.world.fast else 1.0
+        return run_episodes(self.world, machine_factory or self.build_machine, episodes, on_episode,
+                            seed=seed, pause=pause, stop=self.stop_event, on_machine=keep)
+
+    def request_stop(self) -> None:
+        """Preempt the running machine and end the episode loop (safe from any thread)."""
+        self.stop_event.set()
+        m = self.machine
+        if m is not None:
+            m.request_preempt()
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self.stop_event.set()
+        m = self.machine
+        if m is not None:
+            m.request_preempt()
+        if self.scene is not None:
+            self.scene.stop()
+        for s in (self.move_to, self.gripper):
+            if s.server is not None:
+                s.server.shutdown(timeout=2.0)
+        self.world.stop()
+
+
+def parse_args(argv: list[str] | None) -> argparse.Namespace:
+    p = argparse.ArgumentParser(prog="fsmscope demo", description="pick-and-place on a simulated arm")
+    p.add_argument("--headless", action="store_true", help="no 3D view (no viser server)")
+    p.add_argument("--episodes", type=int, default=0, help="episodes to run (0: until stopped)")
+    p.add_argument("--record", metavar="FILE", help="record the run (JSON Lines) to FILE")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first episode")
+    p.add_argument("--fast", action="store_true", help="physics as fast as possible, not real time")
+    p.add_argument("--port", type=int, default=0, help="3D view port (0: a free one)")
+    p.add_argument("--verbose", action="store_true", help="print the machine's info/debug log")
+    return p.parse_args(argv)
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    if args.record:
+        print("note: --record is wired by the fsmscope server; sim.demo alone does not record",
+              file=sys.stderr)
+    if not args.verbose:
+        import fsm
+
+        def quiet(msg):
+            pass
+
+        fsm.set_loggers(quiet, lambda m: print("[ WARN ] " + str(m), file=sys.stderr), quiet,
+                        lambda m: print("[ ERROR ] " + str(m), file=sys.stderr))
+    demo = SimDemo(seed=args.seed, fast=args.fast, scene=not args.headless, port=args.port)
+    if demo.scene is not None:
+        print(f"3D view: {demo.scene.url}", flush=True)
+
+    interrupted: list[int] = []
+
+    def on_signal(signum, frame):
+        interrupted.append(signum)
+        demo.request_stop()
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    results: list[dict] = []
+    failure: list[BaseException] = []
+
+    def work():
+        try:
+            results.extend(demo.run(args.episodes, on_episode=lambda info: print(
+                "episode {episode} seed {seed}: {outcome} (cube {cube_target_distance:.3f} m from "
+                "target, {attempts} attempt(s), {sim_time:.1f} s simulated, {wall_time:.2f} s wall)"
+                .format(**info), flush=True)))
+        except BaseException as exc:  # reported below, after cleanup
+            failure.append(exc)
+
+    worker = threading.Thread(target=work, name="sim-episodes", daemon=True)
+    worker.start()
+    try:
+        while worker.is_alive():
+            worker.join(0.2)
+    finally:
+        demo.close()
+        worker.join(5.0)
+        for s, h in old.items():
+            signal.signal(s, h)
+    if failure:
+        raise failure[0]
+    if interrupted:
+        return 130
+    ok = all(r["outcome"] == "succeeded" for r in results)
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,182 @@
+"""Machine handles: what a control request can do to a machine of this process.
+
+Every call here may block briefly on the machine's own locks, so the app runs them in a
+worker thread, never on the event loop.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+from fsm import introspection
+
+
+class ControlError(Exception):
+    """A request the machine cannot honour now; ``status`` is the HTTP status to answer."""
+
+    def __init__(self, status: int, message: str) -> None:
+        super().__init__(message)
+        self.status = status
+        self.message = message
+
+
+def find_node(root: dict | None, path: str) -> dict | None:
+    if root is None:
+        return None
+    if root["path"] == path:
+        return root
+    if not path.startswith(root["path"] + "/"):
+        return None
+    for child in root.get("children", ()):
+        found = find_node(child, path)
+        if found is not None:
+            return found
+    return None
+
+
+class MachineHandle:
+    """Preempt, set the initial state of, and re-run one local machine."""
+
+    def __init__(self, machine: Any, reporter: introspection.Reporter, can_start: bool) -> None:
+        self.machine = machine
+        self.reporter = reporter
+        self.can_start = can_start
+        self.observer: Any = None
+        self._lock = threading.Lock()
+        self._thread: threading.Thread | None = None
+        self._pending: list[tuple[Any, list[str], dict | None]] = []
+        self._hook_installed = False
+        self.last_outcome: Any = None
+
+    def is_running(self) -> bool:
+        running = getattr(self.machine, "is_running", None)
+        if callable(running) and running():
+            return True
+        thread = self._thread
+        return thread is not None and thread.is_alive()
+
+    def emit_control(self, action: str, client: str, result: str, reason: str | None = None,
+                     params: dict | None = None, path: str | None = None) -> int:
+        event = self.reporter.emit("control", path or self.reporter.root_path,
+                                   {"action": action, "reason": reason, "client": client, "result": result,
+                                    "params": params or {}})
+        return event["seq"] if event is not None else self.reporter.last_seq
+
+    # Preempt (the /sm_stop of this world).
+    def preempt(self, reason: str | None, client: str) -> int:
+        if not self.is_running():
+            self.emit_control("preempt", client, "not running", reason)
+            raise ControlError(409, "machine is not running")
+        seq = self.emit_control("preempt", client, "accepted", reason)
+        self.machine.request_preempt()
+        return seq
+
+    # Initial state ('Set as Initial State').
+    def container_at(self, path: str) -> Any:
+        root_path = self.reporter.root_path
+        if path == root_path:
+            return self.machine
+        if not path.startswith(root_path + "/"):
+            return None
+        state = self.machine
+        for label in path[len(root_path) + 1:].split("/"):
+            children = state.get_children() if hasattr(state, "get_children") else None
+            if not children or label not in children:
+                return None
+            state = children[label]
+        return state
+
+    def set_initial_state(self, path: str | None, states: list[str], userdata: dict | None, client: str) -> int:
+        path = path or self.reporter.root_path
+        params = {"path": path, "states": states, "userdata_keys": sorted(userdata or {})}
+        try:
+            container = self.container_at(path)
+            if container is None:
+                raise ControlError(404, "no state at path %r" % path)
+            if not hasattr(container, "get_children"):
+                raise ControlError(422, "%r is a state, not a container" % path)
+            self._check_states(container, states)
+        except ControlError as err:
+            self.emit_control("initial-state", client, err.message, params=params, path=path)
+            raise
+        with self._lock:
+            deferred = self.is_running()
+            if deferred:
+                self._pending.append((container, states, userdata))
+                self._install_hook()
+            else:
+                self._apply(container, states, userdata)
+        return self.emit_control("initial-state", client, "accepted", params=dict(params, deferred=deferred),
+                                 path=path)
+
+    @staticmethod
+    def _check_states(container: Any, states: list[str]) -> None:
+        kind = type(container).__name__
+        children = container.get_children()
+        unknown = [s for s in states if s not in children]
+        if unknown:
+            raise ControlError(422, "unknown states %s in %s (states: %s)" % (unknown, kind, sorted(children)))
+        if not states:
+            return
+        if hasattr(container, "_outcome_map") and hasattr(container, "_default_outcome"):  # Concurrence
+            raise ControlError(422, "a Concurrence starts all its children; it takes no initial states")
+        if len(states) > 1:
+            raise ControlError(422, "a %s has exactly one initial state" % kind)
+
+    @staticmethod
+    def _apply(container: Any, states: list[str], userdata: dict | None) -> None:
+        container.set_initial_state(list(states), userdata if userdata else None)
+
+    def _install_hook(self) -> None:
+        if not self._hook_installed:
+            self._hook_installed = True
+            introspection.add_global_hook(self._on_top_level_start)
+
+    def _on_top_level_start(self, container: Any) -> None:
+        """A deferred initial state takes effect as the machine starts its next run."""
+        if container is not self.machine:
+            return
+        with self._lock:
+            pending, self._pending = self._pending, []
+        for target, states, userdata in pending:
+            self._apply(target, states, userdata)
+
+    # Re-run.
+    def start(self, client: str) -> int:
+        with self._lock:
+            if not self.can_start:
+                self.emit_control("start", client, "this process cannot re-run the machine")
+                raise ControlError(409, "this process cannot re-run the machine (can_start is false)")
+            if self.is_running():
+                self.emit_control("start", client, "already running")
+                raise ControlError(409, "machine is running")
+            pending, self._pending = self._pending, []
+            for target, states, userdata in pending:
+                self._apply(target, states, userdata)
+            seq = self.emit_control("start", client, "accepted")
+            thread = threading.Thread(target=self._run, name="fsmscope-run-%s" % self.reporter.machine, daemon=True)
+            self._thread = thread
+            thread.start()
+        return seq
+
+    def _run(self) -> None:
+        try:
+            self.last_outcome = self.machine.execute()
+        except BaseException:  # reported as error and terminate events by the runtime
+            self.last_outcome = None
+
+    def join(self, timeout: float | None = None) -> None:
+        thread = self._thread
+        if thread is not None:
+            thread.join(timeout)
+
+
+def publish(topic: str, message: Any) -> int:
+    """Publish on the in-process bus; returns how many subscribers it reached."""
+    from fsm.bus import default_bus
+
+    subscribers = getattr(default_bus, "_subscribers", {}).get(topic, ())
+    count = len(subscribers)
+    result = default_bus.publish(topic, message)
+    return result if isinstance(result, int) and not isinstance(result, bool) else count

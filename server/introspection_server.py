@@ -1,0 +1,146 @@
+"""Serve the dashboard from inside a program, the smach_ros way.
+
+    sis = IntrospectionServer("server_name", sm, "/SM_ROOT")
+    sis.start()          # a web server in a background thread, attached to sm
+    print(sis.url)       # http://127.0.0.1:PORT/?token=...
+    outcome = sm.execute()
+    sis.stop()
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+from typing import Any
+
+from .hub import Hub
+from .security import check_bind, new_token
+
+
+def ws_implementation() -> str:
+    try:
+        import uvicorn.protocols.websockets.websockets_sansio_impl  # noqa: F401
+        return "websockets-sansio"
+    except Exception:
+        return "websockets"
+
+
+def bind_socket(host: str, port: int) -> socket.socket:
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.bind((host, port))
+    sock.listen(128)
+    sock.set_inheritable(True)
+    return sock
+
+
+def uvicorn_config(app: Any, log_level: str = "warning") -> Any:
+    import uvicorn
+
+    return uvicorn.Config(app, ws=ws_implementation(), ws_per_message_deflate=False, log_level=log_level,
+                          lifespan="on", ws_max_size=8 * 1024 * 1024, access_log=False)
+
+
+def display_url(host: str, port: int, token: str | None) -> str:
+    shown = "127.0.0.1" if host in ("0.0.0.0", "") else ("[::1]" if host == "::" else host)
+    if ":" in shown and not shown.startswith("["):
+        shown = "[%s]" % shown
+    url = "http://%s:%d/" % (shown, port)
+    return url + ("?token=%s" % token if token else "")
+
+
+class ServerThread:
+    """A hub's app served by uvicorn in a background thread on a socket bound before it starts."""
+
+    def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
+                 log_level: str = "warning") -> None:
+        from .app import create_app
+        import uvicorn
+
+        self.token = new_token() if token is None else token
+        check_bind(host, self.token)
+        self.hub = hub if hub is not None else Hub()
+        self.host = host
+        self.sock = bind_socket(host, port)
+        self.port = self.sock.getsockname()[1]
+        self.app = create_app(self.hub, self.token, host=host, port=self.port)
+        self.server = uvicorn.Server(uvicorn_config(self.app, log_level))
+        self._thread: threading.Thread | None = None
+
+    @property
+    def url(self) -> str:
+        return display_url(self.host, self.port, self.token)
+
+    @property
+    def base_url(self) -> str:
+        return display_url(self.host, self.port, None).rstrip("/")
+
+    def start(self, timeout: float = 10.0) -> ServerThread:
+        self._thread = threading.Thread(target=self.server.run, kwargs={"sockets": [self.sock]},
+                                        name="fsmscope-server", daemon=True)
+        self._thread.start()
+        deadline = threading.Event()
+        for _ in range(int(timeout / 0.01)):
+            if self.server.started or not self._thread.is_alive():
+                break
+            deadline.wait(0.01)
+        if not self.server.started:
+            raise RuntimeError("the fsmscope server did not start")
+        return self
+
+    def stop(self, timeout: float = 5.0) -> None:
+        self.server.should_exit = True
+        if self._thread is not None:
+            self._thread.join(timeout)
+            if self._thread.is_alive():
+                self.server.force_exit = True
+                self._thread.join(timeout)
+        try:
+            self.sock.close()
+        except OSError:
+            pass
+
+
+class IntrospectionServer:
+    """smach_ros.IntrospectionServer's call shape: ``(name, machine, path)``, then ``start()`` and ``stop()``."""
+
+    def __init__(self, name: str, machine: Any, path: str = "/SM_ROOT", host: str = "127.0.0.1", port: int = 0,
+                 token: str | None = None, can_start: bool = True) -> None:
+        self.name = name
+        self.machine = machine
+        self.path = path
+        self._server = ServerThread(host=host, port=port, token=token)
+        self.hub = self._server.hub
+        self.entry = self.hub.add_local(machine, name=name, path=path, can_start=can_start)
+        self._started = False
+
+    @property
+    def url(self) -> str:
+        return self._server.url
+
+    @property
+    def port(self) -> int:
+        return self._server.port
+
+    @property
+    def token(self) -> str | None:
+        return self._server.token
+
+    def start(self) -> IntrospectionServer:
+        if not self._started:
+            self._server.start()
+            self._started = True
+        return self
+
+    def stop(self) -> None:
+        if self._started:
+            self._started = False
+            self._server.stop()
+        self.hub.remove(self.entry.name)
+
+    def __enter__(self) -> IntrospectionServer:
+        return self.start()
+
+    def __exit__(self, *exc: Any) -> None:
+        self.stop()

@@ -13,6 +13,8 @@ viser runs its own server thread and event loop; it is bound to 127.0.0.1 here
 
 from __future__ import annotations
 
+import contextlib
+import io
 import socket
 import threading
 import time
@@ -40,7 +42,10 @@ class Scene:
         self.rate = rate
         self.always = always  # update even with no browser connected (e.g. to record)
         self.frames = 0
-        self.server = viser.ViserServer(host=host, port=port or _free_port(host), verbose=False)
+        # viser prints a banner with rich whatever ``verbose`` says; our caller prints the
+        # URL itself. (redirect_stdout is process-wide, but only for the constructor.)
+        with contextlib.redirect_stdout(io.StringIO()):
+            self.server = viser.ViserServer(host=host, port=port or _free_port(host), verbose=False)
         self.port = self.server.get_port()
         self.host = host
         # mjviser writes visual scales into the model it is given: give it a copy
@@ -50,8 +55,8 @@ class Scene:
         self.bridge = ViserMujocoScene(self.server, model, num_envs=1)
         self.bridge.camera_tracking_enabled = False  # keep the world frame fixed
         self.server.scene.set_up_direction("+z")
-        self.server.initial_camera.position = (1.35, -1.1, 1.25)
-        self.server.initial_camera.look_at = (0.3, 0.0, 0.45)
+        self.server.initial_camera.position = (1.1, -0.85, 1.0)
+        self.server.initial_camera.look_at = (0.3, 0.0, 0.5)
         self._label_text = None
         self.label = self.server.scene.add_label(
             "/state_label", text="", position=(0.25, 0.0, 1.05), font_screen_scale=1.4,

@@ -1,0 +1,59 @@
+// Fetch wrappers for the REST API (docs/api.md). Same origin, the HttpOnly cookie authenticates;
+// JSON bodies; every failure becomes an ApiError carrying the server's `detail`.
+
+export class ApiError extends Error {
+  constructor(status, detail) {
+    super(status ? `${status}: ${detail}` : detail);
+    this.status = status; // 0 when the server could not be reached
+    this.detail = detail;
+  }
+}
+
+async function request(method, url, body, accept = "json") {
+  const init = { method, credentials: "same-origin", cache: "no-store", headers: {} };
+  if (body !== undefined) {
+    init.headers["Content-Type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  let response;
+  try {
+    response = await fetch(url, init);
+  } catch (err) {
+    throw new ApiError(0, "server unreachable");
+  }
+  if (!response.ok) {
+    let detail = response.statusText || "request failed";
+    try {
+      const data = await response.json();
+      if (data && data.detail !== undefined) {
+        detail = typeof data.detail === "string" ? data.detail : JSON.stringify(data.detail);
+      }
+    } catch (err) { /* not JSON: keep the status text */ }
+    throw new ApiError(response.status, detail);
+  }
+  return accept === "text" ? response.text() : response.json();
+}
+
+const machine = (name) => "/api/machines/" + encodeURIComponent(name);
+
+export const api = {
+  health: () => request("GET", "/api/health"),
+  machines: () => request("GET", "/api/machines"),
+  structure: (name) => request("GET", machine(name) + "/structure"),
+  status: (name) => request("GET", machine(name) + "/status"),
+  graphSvg(name, expand) {
+    const query = new URLSearchParams();
+    for (const path of expand || []) query.append("expand", path);
+    const qs = query.toString();
+    return request("GET", machine(name) + "/graph.svg" + (qs ? "?" + qs : ""), undefined, "text");
+  },
+  preempt: (name, reason) => request("POST", machine(name) + "/preempt", { reason: reason || "" }),
+  setInitialState: (name, path, states, userdata) =>
+    request("POST", machine(name) + "/initial-state", { path, states, userdata }),
+  start: (name) => request("POST", machine(name) + "/start", {}),
+  streamUrl(name, since) {
+    const proto = location.protocol === "https:" ? "wss:" : "ws:";
+    const qs = since ? "?since=" + encodeURIComponent(since) : "";
+    return `${proto}//${location.host}${machine(name)}/stream${qs}`;
+  },
+};

@@ -1,0 +1,465 @@
+// Wiring: machine picker, stream -> Status -> graph/tree/userdata/log, controls, connection badge.
+
+import { api, ApiError } from "./api.js";
+import { Stream } from "./stream.js";
+import { Status, containers, allNodes } from "./status.js";
+import { GraphView } from "./graph.js";
+import { TreeView, UserdataPanel, EventLog, parentPath } from "./panels.js";
+import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
+
+const $ = (id) => document.getElementById(id);
+const MACHINE_POLL_MS = 2000;
+
+const app = {
+  machines: [],
+  name: null,
+  status: null,
+  stream: null,
+  nodes: new Map(), // path -> structure node
+  structureKey: null,
+  selected: null,
+  changed: new Map(), // container path -> Set of keys written by its last transition
+  pendingChanges: new Map(), // container path -> Set of keys written since its last transition
+  lastEdge: new Map(), // container path -> e: id of its last transition
+  expand: null, // null: the server's default; else a Set of container paths drawn open
+  preemptAsked: false,
+  renderQueued: false,
+  online: true,
+};
+
+// ---------------------------------------------------------------- views
+
+const graph = new GraphView($("graph"), {
+  select: (path) => select(path),
+  contextmenu: (path, x, y) => stateMenu(path, x, y),
+  toggle: (path, isCluster) => toggleExpand(path, isCluster),
+  userPanned: () => {
+    $("follow").checked = false;
+    graph.follow = false;
+  },
+});
+const tree = new TreeView($("tree"), {
+  select: (path) => select(path),
+  contextmenu: (path, x, y) => stateMenu(path, x, y),
+});
+const userdata = new UserdataPanel($("userdata"), $("ud-container"), {
+  pick: (path) => select(path),
+  redraw: () => queueRender(),
+});
+const log = new EventLog($("log"), {
+  kind: $("log-kind"), path: $("log-path"), count: $("log-count"), clear: $("log-clear"),
+}, { select: (path) => select(path) });
+log.nodeOf = (path) => app.nodes.get(path);
+
+// ---------------------------------------------------------------- notices
+
+let noticeTimer = null;
+function notice(text, level = "info", sticky = false) {
+  const el = $("notice");
+  el.textContent = text;
+  el.className = "notice " + level;
+  clearTimeout(noticeTimer);
+  if (!sticky) noticeTimer = setTimeout(() => { el.textContent = ""; el.className = "notice"; }, 8000);
+}
+
+function banner(text) {
+  const el = $("banner");
+  el.textContent = text || "";
+  el.hidden = !text;
+}
+
+// ---------------------------------------------------------------- machines
+
+function currentEntry() {
+  return app.machines.find((m) => m.name === app.name) || null;
+}
+
+async function pollMachines() {
+  try {
+    const list = await api.machines();
+    app.online = true;
+    banner("");
+    app.machines = Array.isArray(list) ? list : [];
+    fillPicker();
+    if (!app.name || !app.machines.some((m) => m.name === app.name)) {
+      const wanted = decodeURIComponent((location.hash.match(/m=([^&]*)/) || [])[1] || "");
+      const pick = app.machines.find((m) => m.name === wanted) || app.machines.find((m) => m.running) || app.machines[0];
+      if (pick && pick.name !== app.name) openMachine(pick.name);
+    }
+    updateControls();
+  } catch (err) {
+    app.online = false;
+    if (err instanceof ApiError && err.status === 401) {
+      banner("Not authorized: open the address the server printed (the one with ?token=...).");
+    } else {
+      banner("");
+    }
+    updateControls();
+  } finally {
+    setTimeout(pollMachines, MACHINE_POLL_MS);
+  }
+}
+
+function fillPicker() {
+  const picker = $("machine-picker");
+  const have = [...picker.options].map((o) => o.value + "\u0000" + o.textContent).join("\u0001");
+  const labels = app.machines.map((m) => {
+    const state = m.running ? "running" : m.outcome ? "→ " + m.outcome : "idle";
+    return [m.name, `${m.name}  (${state}${m.source === "ingest" ? ", remote" : ""})`];
+  });
+  if (labels.map(([v, t]) => v + "\u0000" + t).join("\u0001") === have) return;
+  picker.replaceChildren(...labels.map(([value, text]) => {
+    const o = document.createElement("option");
+    o.value = value;
+    o.textContent = text;
+    return o;
+  }));
+  if (app.name) picker.value = app.name;
+}
+
+$("machine-picker").addEventListener("change", (e) => openMachine(e.target.value));
+
+function openMachine(name) {
+  if (app.stream) app.stream.stop();
+  app.name = name;
+  history.replaceState(null, "", "#m=" + encodeURIComponent(name));
+  $("machine-picker").value = name;
+  app.status = new Status(name);
+  app.nodes = new Map();
+  app.structureKey = null;
+  app.selected = null;
+  app.changed = new Map();
+  app.pendingChanges = new Map();
+  app.lastEdge = new Map();
+  app.expand = null;
+  app.preemptAsked = false;
+  graph.clear("Waiting for the machine's structure…");
+  tree.build(null);
+  userdata.show(null);
+  log.reset();
+  app.stream = new Stream(name, {
+    snapshot: onSnapshot,
+    events: onEvents,
+    missed: (count) => notice(`${count} events missed: resynchronised from a snapshot`, "warn"),
+    state: () => updateBadge(),
+  }, {
+    url: (n, since) => api.streamUrl(n, since),
+    checkResume: async (since) => {
+      // A restarted server numbers its events from 1 again: then ask for a snapshot.
+      const list = await api.machines();
+      const entry = list.find((m) => m.name === name);
+      return Boolean(entry) && entry.last_seq >= since;
+    },
+  });
+  app.stream.start();
+  queueRender();
+}
+
+// ---------------------------------------------------------------- stream handling
+
+function onSnapshot(status) {
+  app.status = Status.fromDict({ machine: app.name, ...status });
+  app.changed = new Map();
+  app.pendingChanges = new Map();
+  app.lastEdge = new Map();
+  structureChanged();
+  queueRender();
+}
+
+function onEvents(events) {
+  const status = app.status;
+  for (const ev of events) {
+    if (ev.v !== undefined && ev.v !== 1) continue; // a schema this page does not know
+    status.apply(ev);
+    track(ev);
+    if (ev.kind === "structure") structureChanged();
+  }
+  log.add(events);
+  queueRender();
+}
+
+/** What the reducer does not keep but the page shows: last edges, changed keys, outcomes. */
+function track(ev) {
+  const path = ev.path;
+  switch (ev.kind) {
+    case "start":
+      app.pendingChanges.set(path, new Set());
+      app.changed.set(path, new Set());
+      app.lastEdge.delete(path);
+      break;
+    case "userdata": {
+      const pending = app.pendingChanges.get(path) || new Set();
+      for (const key of Object.keys(ev.changes || {})) pending.add(key);
+      app.pendingChanges.set(path, pending);
+      app.changed.set(path, new Set(pending));
+      break;
+    }
+    case "transition":
+      app.changed.set(path, app.pendingChanges.get(path) || new Set());
+      app.pendingChanges.set(path, new Set());
+      app.lastEdge.set(path, `e:${path}:${ev.from}:${ev.outcome}`);
+      break;
+    case "terminate": {
+      app.changed.set(path, app.pendingChanges.get(path) || new Set());
+      app.pendingChanges.set(path, new Set());
+      const last = ev.last && ev.last.length === 1 ? ev.last[0] : null;
+      const node = app.nodes.get(path);
+      if (last && node && ev.outcome) {
+        const tr = (node.transitions || []).find((t) => t.from === last
+          && (t.to === ev.outcome || (t.to === null && t.outcome === ev.outcome)));
+        if (tr) app.lastEdge.set(path, `e:${path}:${last}:${tr.outcome}`);
+      }
+      if (path === app.status.root_path) {
+        const outcome = ev.outcome === null ? "no outcome" + (ev.error ? ` (${ev.error})` : "") : `outcome '${ev.outcome}'`;
+        notice(`${app.name} finished: ${outcome}`, ev.outcome === null ? "error" : app.preemptAsked ? "warn" : "ok", true);
+        app.preemptAsked = false;
+      }
+      break;
+    }
+    case "error":
+      notice(`${ev.exc_type}: ${ev.message}`, "error", true);
+      break;
+    default:
+  }
+}
+
+function structureChanged() {
+  const root = app.status.structure;
+  const key = root ? JSON.stringify(root) : null;
+  if (key === app.structureKey) return;
+  app.structureKey = key;
+  app.nodes = new Map();
+  for (const node of allNodes(root)) app.nodes.set(node.path, node);
+  tree.build(root);
+  const all = root ? [...containers(root)] : [];
+  userdata.setContainers(all);
+  if (!userdata.path || !app.nodes.has(userdata.path)) userdata.show(root ? root.path : null);
+  if (app.expand) app.expand = new Set([...app.expand].filter((p) => app.nodes.has(p)));
+  fillDepth(all);
+  loadGraph();
+}
+
+// ---------------------------------------------------------------- graph layout (structure + expand set)
+
+function depthOf(path) {
+  const root = app.status.root_path || "";
+  return path === root ? 0 : path.slice(root.length).split("/").length - 1;
+}
+
+function fillDepth(all) {
+  const select = $("depth");
+  const max = all.reduce((m, n) => Math.max(m, depthOf(n.path) + 1), 1);
+  const current = select.value;
+  const options = [["auto", "auto"]];
+  for (let d = 1; d <= max; d++) options.push([String(d), String(d)]);
+  options.push(["custom", "custom"]);
+  select.replaceChildren(...options.map(([value, text]) => {
+    const o = document.createElement("option");
+    o.value = value;
+    o.textContent = text;
+    if (value === "custom") o.hidden = true;
+    return o;
+  }));
+  select.value = options.some(([v]) => v === current) ? current : "auto";
+}
+
+$("depth").addEventListener("change", (e) => {
+  const value = e.target.value;
+  if (value === "auto") app.expand = null;
+  else if (value !== "custom") {
+    const d = Number(value);
+    app.expand = new Set([...containers(app.status.structure)].map((n) => n.path).filter((p) => depthOf(p) < d));
+  }
+  loadGraph();
+});
+
+function toggleExpand(path, isCluster) {
+  const node = app.nodes.get(path);
+  if (!node || !node.container || path === app.status.root_path) return;
+  if (!app.expand) {
+    // From the server's default: open what it opened (clusters in the current SVG).
+    app.expand = new Set([...$("graph").querySelectorAll("g.cluster")].map((g) => g.id)
+      .filter((id) => id.startsWith("c:")).map((id) => id.slice(2)));
+    app.expand.add(app.status.root_path);
+  }
+  if (isCluster || app.expand.has(path)) {
+    for (const p of [...app.expand]) if (p === path || p.startsWith(path + "/")) app.expand.delete(p);
+  } else {
+    for (let p = path; p; p = parentPath(p)) app.expand.add(p);
+  }
+  $("depth").value = "custom";
+  loadGraph();
+}
+
+async function loadGraph() {
+  const name = app.name;
+  if (!app.status.structure) return;
+  const expand = app.expand ? [...app.expand].sort() : null;
+  const key = JSON.stringify([name, app.structureKey, expand]);
+  try {
+    const changed = await graph.load(key, () => api.graphSvg(name, expand));
+    if (changed) queueRender();
+  } catch (err) {
+    if (name === app.name) graph.clear("Could not draw the graph: " + (err.detail || err.message));
+  }
+}
+
+$("fit").addEventListener("click", () => graph.fit());
+$("zoom-in").addEventListener("click", () => graph.zoom(1.25));
+$("zoom-out").addEventListener("click", () => graph.zoom(0.8));
+$("follow").addEventListener("change", (e) => {
+  graph.follow = e.target.checked;
+  queueRender();
+});
+
+// ---------------------------------------------------------------- selection and menus
+
+function select(path) {
+  app.selected = path || null;
+  tree.select(app.selected);
+  if (path) {
+    const node = app.nodes.get(path);
+    userdata.show(node && node.container ? path : parentPath(path) || path);
+  }
+  queueRender();
+}
+
+function stateMenu(path, x, y) {
+  const node = app.nodes.get(path);
+  const container = parentPath(path);
+  const parent = container ? app.nodes.get(container) : null;
+  select(path);
+  const local = currentEntry()?.source !== "ingest";
+  const takesInitial = parent && parent.type !== "Concurrence" && parent.type !== "Iterator";
+  showMenu(x, y, path, [
+    {
+      label: "Set as initial state…",
+      disabled: !node || !parent || !local || !takesInitial,
+      title: !parent ? "the root has no parent container" : !takesInitial ? `a ${parent.type} has no initial state to choose` : "",
+      action: () => setInitial(container, node.label),
+    },
+    { label: node && node.container ? "Show userdata" : "Show container userdata", action: () => {
+      userdata.show(node?.container ? path : container);
+      queueRender();
+    } },
+    { label: "Center in graph", action: () => graph.reveal(graph.stateElement(path)) },
+  ]);
+}
+
+async function setInitial(container, state) {
+  const ud = app.status.containers[container]?.userdata || {};
+  const ok = await editInitialState({
+    container, state, userdata: ud,
+    submit: (value) => api.setInitialState(app.name, container, [state], value),
+  });
+  if (ok) notice(`Initial state of ${container} set to ${state} (next run)`, "ok");
+}
+
+// ---------------------------------------------------------------- controls
+
+$("preempt-btn").addEventListener("click", async () => {
+  const name = app.name;
+  const answer = await confirmPreempt(name);
+  if (!answer) return;
+  try {
+    const ack = await api.preempt(name, answer.reason);
+    app.preemptAsked = true;
+    notice(`Preempt accepted (event ${ack.seq}): waiting for the outcome…`, "warn", true);
+  } catch (err) {
+    notice("Preempt failed: " + (err.detail || err.message), "error", true);
+  }
+});
+
+$("start-btn").addEventListener("click", async () => {
+  try {
+    const ack = await api.start(app.name);
+    notice(`Start accepted (event ${ack.seq})`, "ok");
+  } catch (err) {
+    notice("Start failed: " + (err.detail || err.message), "error", true);
+  }
+});
+
+function updateControls() {
+  const entry = currentEntry();
+  const running = app.status ? app.status.running : false;
+  const live = app.online && app.stream?.state === "live";
+  $("preempt-btn").disabled = !live || !running || entry?.source === "ingest";
+  $("start-btn").disabled = !live || running || !entry || !entry.can_start;
+  const pill = $("run-state");
+  let text = "—";
+  let cls = "idle";
+  const s = app.status;
+  if (s && s.structure) {
+    if (s.running) [text, cls] = ["running", "running"];
+    else if (s.error && s.outcome === null) [text, cls] = ["failed: " + (s.error.exc_type || "error"), "failed"];
+    else if (s.outcome !== null && s.outcome !== undefined) [text, cls] = ["finished: " + s.outcome, "done"];
+    else [text, cls] = ["idle", "idle"];
+  }
+  if (pill.textContent !== text) pill.textContent = text;
+  pill.className = "pill " + cls;
+  pill.title = s?.error ? `${s.error.exc_type || ""} ${s.error.message || ""}`.trim() : "";
+}
+
+// ---------------------------------------------------------------- badge
+
+function updateBadge() {
+  const badge = $("badge");
+  const stream = app.stream;
+  const state = !stream ? "idle" : stream.state;
+  let cls = "down";
+  let text = state;
+  if (state === "live") {
+    cls = "live";
+    const rate = stream.rate();
+    const lat = stream.latencyMs;
+    text = `live · ${rate < 10 ? rate.toFixed(1) : Math.round(rate)} ev/s · ${lat === null ? "–" : lat < 10 ? lat.toFixed(1) : Math.round(lat)} ms`;
+  } else if (state === "reconnecting" || state === "connecting") {
+    cls = "wait";
+    text = app.online ? state + "…" : "server unreachable · retrying";
+  }
+  if (stream && stream.missed) text += ` · missed ${stream.missed}`;
+  badge.className = "badge " + cls;
+  badge.dataset.state = state;
+  const label = badge.querySelector(".badge-text");
+  if (label.textContent !== text) label.textContent = text;
+  updateControls();
+}
+setInterval(updateBadge, 500);
+
+// ---------------------------------------------------------------- render
+
+function queueRender() {
+  if (app.renderQueued) return;
+  app.renderQueued = true;
+  requestAnimationFrame(render);
+}
+
+function render() {
+  app.renderQueued = false;
+  const s = app.status;
+  if (!s) return;
+  const active = s.activePaths();
+  const running = Object.entries(s.containers).filter(([, c]) => c.running).map(([p]) => p);
+  const reached = Object.entries(s.containers)
+    .filter(([, c]) => !c.running && c.outcome !== null && c.outcome !== undefined)
+    .map(([p, c]) => `o:${p}:${c.outcome}`);
+  const failed = [];
+  if (s.error && s.error.path) failed.push(s.error.state ? s.error.path + "/" + s.error.state : s.error.path);
+  graph.apply({ active, running, reached, lastEdges: [...app.lastEdge.values()], failed, selected: app.selected });
+  tree.update(s);
+  const udPath = userdata.path;
+  userdata.update(s, udPath ? app.nodes.get(udPath) : null, udPath ? app.changed.get(udPath) : null);
+  updateControls();
+}
+
+// ---------------------------------------------------------------- go
+
+document.addEventListener("keydown", (e) => {
+  if (e.target.closest("input, textarea, select, dialog")) return;
+  if (e.key === "f") graph.fit();
+  else if (e.key === "+" || e.key === "=") graph.zoom(1.25);
+  else if (e.key === "-") graph.zoom(0.8);
+});
+
+window.fsmscope = app; // for debugging in the console and for the browser tests
+pollMachines();

@@ -1,0 +1,281 @@
+// The machine graph: the server's Graphviz SVG (one layout per structure + expand set),
+// sanitized and inlined; status only toggles CSS classes on the stable ids of docs/api.md
+// (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME), so the layout never moves when
+// only the status changes. Pan (drag) and zoom (wheel) act on the SVG's viewBox.
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+const DROP_ELEMENTS = new Set(["script", "foreignobject", "iframe", "object", "embed", "image", "use", "animate",
+  "set", "animatemotion", "animatetransform", "handler", "listener", "style"]);
+
+/** Remove anything active from a parsed SVG: scripts, foreign content, event handlers, external links. */
+export function sanitizeSvg(root) {
+  const doomed = [];
+  for (const el of [root, ...root.querySelectorAll("*")]) {
+    if (DROP_ELEMENTS.has(el.localName.toLowerCase())) {
+      doomed.push(el);
+      continue;
+    }
+    for (const attr of [...el.attributes]) {
+      const name = attr.name.toLowerCase();
+      const value = attr.value.trim().toLowerCase();
+      if (name.startsWith("on")
+          || ((name === "href" || name.endsWith(":href") || name === "src") && !value.startsWith("#"))
+          || (name === "style" && (value.includes("url(") || value.includes("javascript:")))) {
+        el.removeAttribute(attr.name);
+      }
+    }
+  }
+  for (const el of doomed) el.remove();
+  return root;
+}
+
+/** Parse SVG text into a sanitized <svg> element of this document (never innerHTML). */
+export function parseSvg(text) {
+  const doc = new DOMParser().parseFromString(text, "image/svg+xml");
+  const svg = doc.documentElement;
+  if (!svg || svg.localName !== "svg" || svg.namespaceURI !== SVG_NS || doc.querySelector("parsererror")) {
+    throw new Error("the server's graph is not valid SVG");
+  }
+  sanitizeSvg(svg);
+  return document.importNode(svg, true);
+}
+
+function parentPath(path) {
+  const i = path.lastIndexOf("/");
+  return i > 0 ? path.slice(0, i) : null;
+}
+
+export class GraphView {
+  /**
+   * @param {HTMLElement} host the element the SVG goes in
+   * @param {object} handlers {select(path), contextmenu(path, x, y), toggle(path), userPanned()}
+   */
+  constructor(host, handlers) {
+    this.host = host;
+    this.handlers = handlers;
+    this.svg = null;
+    this.base = null; // the layout's own viewBox {x, y, w, h}
+    this.vb = null;
+    this.key = null; // what the current SVG was laid out for
+    this.classed = new Map(); // class name -> Set of element ids
+    this.follow = true;
+    this.loadToken = 0;
+    this._bindPointer();
+  }
+
+  /** Load the layout for `key` (a string naming structure + expand set) unless already shown. */
+  async load(key, fetchSvg, { keepView = false } = {}) {
+    if (key === this.key) return false;
+    const token = ++this.loadToken;
+    const text = await fetchSvg();
+    if (token !== this.loadToken) return false; // a newer load started meanwhile
+    const svg = parseSvg(text);
+    const vb = svg.viewBox.baseVal;
+    let base;
+    if (vb && vb.width > 0) {
+      base = { x: vb.x, y: vb.y, w: vb.width, h: vb.height };
+    } else {
+      base = { x: 0, y: 0, w: parseFloat(svg.getAttribute("width")) || 100, h: parseFloat(svg.getAttribute("height")) || 100 };
+    }
+    svg.setAttribute("width", "100%");
+    svg.setAttribute("height", "100%");
+    svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
+    svg.removeAttribute("style");
+    svg.classList.add("graph-svg");
+    const previous = this.vb;
+    this.svg = svg;
+    this.base = base;
+    this.key = key;
+    this.classed = new Map();
+    this.host.replaceChildren(svg);
+    if (keepView && previous) this._setViewBox(previous);
+    else this.fit();
+    return true;
+  }
+
+  clear(message) {
+    this.svg = null;
+    this.key = null;
+    this.classed = new Map();
+    const p = document.createElement("p");
+    p.className = "graph-empty";
+    p.textContent = message || "";
+    this.host.replaceChildren(p);
+  }
+
+  el(id) {
+    return this.svg ? document.getElementById(id) : null;
+  }
+
+  /** The element that stands for a state path: itself, or the closest collapsed ancestor. */
+  stateElement(path) {
+    for (let p = path; p; p = parentPath(p)) {
+      const el = this.el("s:" + p) || this.el("c:" + p);
+      if (el) return el;
+    }
+    return null;
+  }
+
+  /** Set `cls` on exactly the elements whose ids are in `ids` (touching only what changed). */
+  _setClass(cls, ids) {
+    const before = this.classed.get(cls) || new Set();
+    for (const id of before) {
+      if (!ids.has(id)) this.el(id)?.classList.remove(cls);
+    }
+    const now = new Set();
+    for (const id of ids) {
+      const el = this.el(id);
+      if (!el) continue;
+      el.classList.add(cls);
+      now.add(id);
+    }
+    this.classed.set(cls, now);
+  }
+
+  /**
+   * @param {object} view {active: [paths], running: [container paths], reached: [o: ids],
+   *   lastEdges: [e: ids], failed: [paths], selected: path|null}
+   */
+  apply(view) {
+    if (!this.svg) return;
+    const active = new Set();
+    let deepest = null;
+    for (const path of view.active) {
+      const el = this.stateElement(path);
+      if (!el) continue;
+      active.add(el.id);
+      if (!deepest || path.length > deepest.path.length) deepest = { path, el };
+    }
+    for (const path of view.running) {
+      if (this.el("c:" + path)) active.add("c:" + path);
+    }
+    this._setClass("active", active);
+    this._setClass("reached", new Set(view.reached));
+    this._setClass("last", new Set(view.lastEdges));
+    const failed = new Set();
+    for (const path of view.failed) {
+      const el = this.stateElement(path);
+      if (el) failed.add(el.id);
+    }
+    this._setClass("failed", failed);
+    const selected = new Set();
+    if (view.selected) {
+      const el = this.stateElement(view.selected);
+      if (el) selected.add(el.id);
+    }
+    this._setClass("selected", selected);
+    if (this.follow && deepest) this.reveal(deepest.el);
+  }
+
+  /** Pan (never zoom) so that `el` is inside the view, when it is not already. */
+  reveal(el) {
+    if (!this.svg || !el) return;
+    const box = el.getBoundingClientRect();
+    const view = this.host.getBoundingClientRect();
+    if (!view.width || !view.height) return;
+    const margin = 24;
+    const inside = box.left >= view.left + margin && box.right <= view.right - margin
+      && box.top >= view.top + margin && box.bottom <= view.bottom - margin;
+    if (inside) return;
+    const ctm = this.svg.getScreenCTM();
+    if (!ctm) return;
+    const k = ctm.a || 1;
+    const dx = (box.left + box.width / 2 - (view.left + view.width / 2)) / k;
+    const dy = (box.top + box.height / 2 - (view.top + view.height / 2)) / k;
+    this._setViewBox({ ...this.vb, x: this.vb.x + dx, y: this.vb.y + dy });
+  }
+
+  fit() {
+    if (!this.base) return;
+    const pad = Math.max(this.base.w, this.base.h) * 0.02;
+    this._setViewBox({ x: this.base.x - pad, y: this.base.y - pad, w: this.base.w + 2 * pad, h: this.base.h + 2 * pad });
+  }
+
+  zoom(factor, clientX, clientY) {
+    if (!this.svg || !this.vb) return;
+    const rect = this.host.getBoundingClientRect();
+    if (clientX === undefined) {
+      clientX = rect.left + rect.width / 2;
+      clientY = rect.top + rect.height / 2;
+    }
+    const p = this._toUser(clientX, clientY);
+    const w = Math.min(Math.max(this.vb.w / factor, this.base.w / 50), this.base.w * 20);
+    const f = w / this.vb.w;
+    this._setViewBox({ x: p.x - (p.x - this.vb.x) * f, y: p.y - (p.y - this.vb.y) * f, w, h: this.vb.h * f });
+  }
+
+  _toUser(clientX, clientY) {
+    const ctm = this.svg.getScreenCTM();
+    const pt = new DOMPoint(clientX, clientY).matrixTransform(ctm ? ctm.inverse() : new DOMMatrix());
+    return { x: pt.x, y: pt.y };
+  }
+
+  _setViewBox(vb) {
+    this.vb = vb;
+    if (this.svg) this.svg.setAttribute("viewBox", `${vb.x} ${vb.y} ${vb.w} ${vb.h}`);
+  }
+
+  _target(event) {
+    const g = event.target.closest?.("g.node, g.cluster");
+    if (!g || !this.svg?.contains(g)) return null;
+    const id = g.id || "";
+    if (id.startsWith("s:") || id.startsWith("c:")) return { path: id.slice(2), cluster: id.startsWith("c:"), el: g };
+    if (id.startsWith("o:")) return { path: id.slice(2, id.lastIndexOf(":")), cluster: true, el: g };
+    return null;
+  }
+
+  _bindPointer() {
+    const host = this.host;
+    let drag = null;
+    host.addEventListener("wheel", (e) => {
+      if (!this.svg) return;
+      e.preventDefault();
+      this.zoom(Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015)), e.clientX, e.clientY);
+    }, { passive: false });
+    host.addEventListener("pointerdown", (e) => {
+      if (!this.svg || e.button !== 0) return;
+      drag = { x: e.clientX, y: e.clientY, vb: { ...this.vb }, k: this.svg.getScreenCTM()?.a || 1, moved: false };
+    });
+    host.addEventListener("pointermove", (e) => {
+      if (!drag) return;
+      const dx = e.clientX - drag.x;
+      const dy = e.clientY - drag.y;
+      if (!drag.moved && Math.hypot(dx, dy) < 4) return;
+      if (!drag.moved) {
+        drag.moved = true;
+        host.setPointerCapture(e.pointerId);
+        host.classList.add("dragging");
+        this.handlers.userPanned?.();
+      }
+      this._setViewBox({ ...drag.vb, x: drag.vb.x - dx / drag.k, y: drag.vb.y - dy / drag.k });
+    });
+    const end = (e) => {
+      if (!drag) return;
+      if (drag.moved) {
+        host.classList.remove("dragging");
+        if (host.hasPointerCapture(e.pointerId)) host.releasePointerCapture(e.pointerId);
+        // The click that follows a drag must not select anything.
+        const swallow = (ev) => { ev.stopPropagation(); };
+        host.addEventListener("click", swallow, { capture: true, once: true });
+        setTimeout(() => host.removeEventListener("click", swallow, { capture: true }), 0);
+      }
+      drag = null;
+    };
+    host.addEventListener("pointerup", end);
+    host.addEventListener("pointercancel", end);
+    host.addEventListener("click", (e) => {
+      const t = this._target(e);
+      this.handlers.select?.(t ? t.path : null);
+    });
+    host.addEventListener("dblclick", (e) => {
+      const t = this._target(e);
+      if (t) this.handlers.toggle?.(t.path, t.cluster);
+    });
+    host.addEventListener("contextmenu", (e) => {
+      const t = this._target(e);
+      if (!t) return;
+      e.preventDefault();
+      this.handlers.contextmenu?.(t.path, e.clientX, e.clientY);
+    });
+  }
+}

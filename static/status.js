@@ -1,0 +1,132 @@
+// The state of one machine rebuilt from its events: a line-for-line mirror of fsm/status.py,
+// so that the browser, the recorder and replay cannot disagree.
+
+const REDUCED = new Set(["start", "transition", "userdata", "terminate", "error"]);
+
+function containerEntry(initial) {
+  return { active: [], initial: [...(initial || [])], userdata: {}, running: false, outcome: null };
+}
+
+/** Every container node of a structure tree, parents first. */
+export function* containers(node) {
+  if (node && node.container) {
+    yield node;
+    for (const child of node.children || []) yield* containers(child);
+  }
+}
+
+/** Every node (containers and leaves) of a structure tree, parents first. */
+export function* allNodes(node) {
+  if (!node) return;
+  yield node;
+  for (const child of node.children || []) yield* allNodes(child);
+}
+
+export class Status {
+  constructor(machine) {
+    this.machine = machine;
+    this.run = null;
+    this.root_path = null;
+    this.structure = null;
+    this.containers = {};
+    this.running = false;
+    this.outcome = null;
+    this.error = null;
+    this.last_seq = 0;
+    this.last_t = null;
+  }
+
+  apply(event) {
+    const kind = event.kind;
+    const path = event.path;
+    this.last_seq = event.seq;
+    this.last_t = event.t === undefined ? null : event.t;
+    if ("run" in event) this.run = event.run;
+    if (kind === "snapshot") {
+      this._load(event.status);
+      return;
+    }
+    if (kind === "structure") {
+      this._setStructure(path, event.root);
+      return;
+    }
+    if (!REDUCED.has(kind)) return;
+    let entry = this.containers[path];
+    if (entry === undefined) entry = this.containers[path] = containerEntry();
+    const root = path === this.root_path;
+    if (kind === "start") {
+      Object.assign(entry, {
+        active: [...event.active], initial: [...event.initial],
+        userdata: { ...event.userdata }, running: true, outcome: null,
+      });
+      if (root) {
+        this.running = true;
+        this.outcome = null;
+        this.error = null;
+      }
+    } else if (kind === "transition") {
+      entry.active = [...event.active];
+    } else if (kind === "userdata") {
+      Object.assign(entry.userdata, event.changes);
+    } else if (kind === "terminate") {
+      Object.assign(entry, { active: [], running: false, outcome: event.outcome });
+      if (root) {
+        this.running = false;
+        this.outcome = event.outcome;
+        if (event.error && this.error === null) this.error = { path, message: event.error };
+      }
+    } else if (kind === "error") {
+      this.error = {};
+      for (const k of ["path", "state", "exc_type", "message", "traceback"]) {
+        this.error[k] = event[k] === undefined ? null : event[k];
+      }
+    }
+  }
+
+  _setStructure(path, root) {
+    this.root_path = path;
+    this.structure = root;
+    const previous = this.containers;
+    this.containers = {};
+    for (const node of containers(root)) {
+      const entry = previous[node.path] || containerEntry();
+      entry.initial = [...(node.initial || [])];
+      this.containers[node.path] = entry;
+    }
+  }
+
+  /** Every active state's full path, at every level. */
+  activePaths() {
+    const out = [];
+    for (const [p, c] of Object.entries(this.containers)) {
+      for (const label of c.active) if (label !== "None") out.push(p + "/" + label);
+    }
+    return out;
+  }
+
+  toDict() {
+    return {
+      machine: this.machine, run: this.run, root_path: this.root_path, structure: this.structure,
+      containers: structuredClone(this.containers), running: this.running, outcome: this.outcome,
+      error: this.error, last_seq: this.last_seq, last_t: this.last_t,
+    };
+  }
+
+  _load(data) {
+    this.run = data.run ?? null;
+    this.root_path = data.root_path ?? null;
+    this.structure = data.structure ?? null;
+    this.containers = structuredClone(data.containers || {});
+    this.running = Boolean(data.running);
+    this.outcome = data.outcome ?? null;
+    this.error = data.error ?? null;
+    this.last_seq = data.last_seq ?? this.last_seq;
+    this.last_t = data.last_t ?? this.last_t;
+  }
+
+  static fromDict(data) {
+    const status = new Status(data.machine);
+    status._load(data);
+    return status;
+  }
+}

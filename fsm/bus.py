@@ -151,9 +151,9 @@ class Bus:
         return self._services.wait(name, timeout, wake)
 
     def call_service(self, name: str, request: Any, timeout: float | None = None) -> Any:
-        """Call the handler in this thread, after waiting up to ``timeout`` s for the service."""
-        if not self._services.wait(name, timeout, None):
-            raise ServiceException("service '%s' is not available" % name)
+        """Call the handler in this thread; with a ``timeout``, first wait that long for the service."""
+        if timeout is not None:
+            self._services.wait(name, timeout, None)
         handle = self._services.get(name)
         if handle is None:
             raise ServiceException("service '%s' is not available" % name)

@@ -6,36 +6,7 @@ import time
 import pytest
 
 from fsm.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
-from fsm.bus import Bus
-
-
-@pytest.fixture
-def bus() -> Bus:
-    return Bus()
-
-
-@pytest.fixture
-def servers():
-    """Servers made by a test, shut down after it."""
-    made = []
-    yield made
-    for server in made:
-        server.shutdown(timeout=1.0)
-
-
-def serve(bus, servers, execute_cb, name="act", **kwargs) -> SimpleActionServer:
-    server = SimpleActionServer(name, execute_cb, bus=bus, **kwargs)
-    servers.append(server)
-    return server
-
-
-def until_preempted(server):
-    """An execute_cb that runs until preempted, then reports it."""
-    def execute(goal):
-        while not server.is_preempt_requested():
-            time.sleep(0.005)
-        server.set_preempted({"stopped": goal}, "stopped")
-    return execute
+from bus_support import bus, serve, servers, until_preempted  # noqa: F401 (fixtures)
 
 
 def test_goal_status_names():

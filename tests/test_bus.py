@@ -5,12 +5,8 @@ import time
 
 import pytest
 
-from fsm.bus import Bus, ServiceException, default_bus, get_bus
-
-
-@pytest.fixture
-def bus() -> Bus:
-    return Bus()
+from bus_support import bus  # noqa: F401 (fixture)
+from fsm.bus import ServiceException, default_bus, get_bus
 
 
 def test_publish_reaches_every_subscriber_of_the_topic_only(bus):

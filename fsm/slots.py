@@ -1,0 +1,18 @@
+"""Message fields by name, for slots on objects with attributes and on dicts alike.
+
+ROS messages expose fields as ``__slots__`` attributes; here a message, request, goal or
+result is any Python object, and plain dicts are common, so both access styles are served.
+"""
+
+from typing import Any
+
+
+def get_slot(msg: Any, name: str) -> Any:
+    return msg[name] if isinstance(msg, dict) else getattr(msg, name)
+
+
+def set_slot(msg: Any, name: str, value: Any) -> None:
+    if isinstance(msg, dict):
+        msg[name] = value
+    else:
+        setattr(msg, name, value)

@@ -1,0 +1,42 @@
+"""Fixtures and helpers shared by the bus, actionlib and smach_ros-state tests."""
+
+import time
+
+import pytest
+
+from fsm.actionlib import SimpleActionServer
+from fsm.bus import Bus
+
+
+@pytest.fixture
+def bus() -> Bus:
+    """A private bus, so tests never see each other's topics, services or servers."""
+    return Bus()
+
+
+@pytest.fixture
+def servers():
+    """Action servers made by a test (through ``serve``), shut down after it."""
+    made: list[SimpleActionServer] = []
+    yield made
+    for server in made:
+        server.shutdown(timeout=1.0)
+
+
+def serve(bus: Bus, servers: list, execute_cb, name: str = "act", **kwargs) -> SimpleActionServer:
+    server = SimpleActionServer(name, execute_cb, bus=bus, **kwargs)
+    servers.append(server)
+    return server
+
+
+def until_preempted(server: SimpleActionServer, result=None):
+    """An execute_cb body that publishes feedback until preempted, then reports the preemption."""
+    def execute(goal):
+        n = 0
+        while not server.is_preempt_requested():
+            server.publish_feedback({"n": n})
+            n += 1
+            time.sleep(0.005)
+        server.set_preempted(result if result is not None else {"stopped": goal}, "stopped")
+    return execute
+

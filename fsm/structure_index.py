@@ -1,0 +1,85 @@
+"""What a machine's ``structure`` events say about each container path, for readers of a log.
+
+Replay needs two facts the other events leave implicit: which kind of container a path
+is (a StateMachine prints different lines from a Concurrence), and which outcome of the
+last state led to a container's termination (a ``terminate`` event carries the container
+outcome; the state's own outcome follows from the container's transitions).
+"""
+
+from __future__ import annotations
+
+from typing import Iterator
+
+STATE_MACHINE_TYPES = ("StateMachine", "Sequence")
+
+
+def _walk(node: dict) -> Iterator[dict]:
+    yield node
+    for child in node.get("children", ()):
+        yield from _walk(child)
+
+
+class StructureIndex:
+    """Per machine, per container path: its structure node (updated by ``structure`` events)."""
+
+    def __init__(self) -> None:
+        self._nodes: dict[tuple[str, str], dict] = {}
+
+    def apply(self, event: dict) -> None:
+        if event.get("kind") == "structure":
+            self.add(event["machine"], event["root"])
+        elif event.get("kind") == "snapshot":
+            root = (event.get("status") or {}).get("structure")
+            if root:
+                self.add(event["machine"], root)
+
+    def add(self, machine: str, root: dict) -> None:
+        for node in _walk(root):
+            if node.get("container"):
+                self._nodes[(machine, node["path"])] = node
+
+    def node(self, machine: str, path: str) -> dict | None:
+        return self._nodes.get((machine, path))
+
+    def container_type(self, event: dict) -> str:
+        """The container class behind ``event["path"]``; guessed from the event without a structure."""
+        node = self._nodes.get((event["machine"], event["path"]))
+        if node is not None:
+            kind = node.get("type", "StateMachine")
+            if kind in STATE_MACHINE_TYPES or kind in ("Concurrence", "Iterator"):
+                return kind
+            if "outcome_map" in node:  # subclasses keep their parent's fields
+                return "Concurrence"
+            if "exhausted_outcome" in node:
+                return "Iterator"
+            return "StateMachine"
+        if event.get("kind") == "transition" and event.get("to") is None:
+            return "Concurrence"
+        if event.get("kind") == "terminate" and "outcomes" in event:
+            return "Concurrence"
+        if event.get("kind") == "transition" and event.get("from") == event.get("to"):
+            return "Iterator"
+        return "StateMachine"
+
+    def state_outcome(self, event: dict) -> str | None:
+        """The last state's outcome that ended a StateMachine (``terminate`` event), best effort.
+
+        Uses the event's own ``state_outcome`` when it has one; otherwise the transition of the
+        last state that leads to the container outcome (preferring the outcome of the same
+        name when several do).
+        """
+        if "state_outcome" in event:
+            return event["state_outcome"]
+        outcome = event.get("outcome")
+        last = (event.get("last") or [None])[0]
+        if outcome is None or last is None:
+            return outcome
+        node = self._nodes.get((event["machine"], event["path"]))
+        if node is None:
+            return outcome
+        candidates = [t["outcome"] for t in node.get("transitions", ())
+                      if t.get("from") == last and (t.get("to") == outcome
+                                                    or (t.get("to") in (None, "") and t.get("outcome") == outcome))]
+        if not candidates or outcome in candidates:
+            return outcome
+        return candidates[0]

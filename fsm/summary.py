@@ -1,0 +1,214 @@
+"""Statistics of a recorded run: outcome, visits and time per state, transitions taken, errors.
+
+``Summary`` takes events one at a time (so a followed log can be summarised as it grows)
+and gives a JSON-safe dict (``to_dict``) or a text table (``format``). A state is active
+from the event that makes it active (its container's ``start``, or the ``transition`` to
+it) to the event that ends it (the ``transition`` from it, or its container's
+``terminate``); a visit still open when the log ends counts as a visit without a time.
+"""
+
+from __future__ import annotations
+
+import statistics
+from typing import Any, Iterable
+
+from .structure_index import StructureIndex
+
+FINISHED = "finished"  # the root container ended with an outcome
+ERROR = "error"  # it ended without one (an exception, a failed check, a shutdown)
+INCOMPLETE = "incomplete"  # the log ends while it runs (the process died), or it never started
+
+
+class _Machine:
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.root_path: str | None = None
+        self.runs = 0
+        self.events = 0
+        self.first_t: float | None = None
+        self.last_t: float | None = None
+        self.run_started: float | None = None
+        self.outcome: str | None = None
+        self.status = INCOMPLETE
+        self.ended_with_error: str | None = None
+        self.visits: dict[str, int] = {}
+        self.durations: dict[str, list[float]] = {}
+        self.entered: dict[str, dict[str, float | None]] = {}  # container path -> {label: entered at}
+        self.transitions: dict[tuple[str, str, str, str | None], int] = {}
+        self.errors: list[dict] = []
+        self.preempts = {"requested": 0, "serviced": 0}
+        self.feedback = 0
+        self.controls: list[dict] = []
+
+    def enter(self, path: str, label: str, t: float | None) -> None:
+        self.entered.setdefault(path, {})[label] = t
+        state = path + "/" + label
+        self.visits[state] = self.visits.get(state, 0) + 1
+
+    def leave(self, path: str, label: str, t: float | None) -> None:
+        started = self.entered.get(path, {}).pop(label, None)
+        if started is not None and t is not None:
+            self.durations.setdefault(path + "/" + label, []).append(max(0.0, t - started))
+
+    def leave_all(self, path: str, t: float | None) -> None:
+        for label in list(self.entered.get(path, {})):
+            self.leave(path, label, t)
+
+    def sync(self, path: str, active: list[str], t: float | None) -> None:
+        current = self.entered.get(path, {})
+        for label in list(current):
+            if label not in active:
+                self.leave(path, label, t)
+        for label in active:
+            if label not in current and label != "None":
+                self.enter(path, label, t)
+
+
+class Summary:
+    """Accumulates the statistics of any number of machines from their events."""
+
+    def __init__(self, structures: StructureIndex | None = None) -> None:
+        self.structures = structures or StructureIndex()
+        self._own_structures = structures is None
+        self.machines: dict[str, _Machine] = {}
+        self.events = 0
+        self.problems: list[Any] = []
+
+    def add(self, event: dict) -> None:
+        kind = event["kind"]
+        if kind == "snapshot":
+            if self._own_structures:
+                self.structures.apply(event)
+            return
+        self.events += 1
+        name = event["machine"]
+        m = self.machines.get(name)
+        if m is None:
+            m = self.machines[name] = _Machine(name)
+        m.events += 1
+        t = event.get("t")
+        if m.first_t is None:
+            m.first_t = t
+        m.last_t = t
+        path = event["path"]
+        if kind == "structure":
+            if self._own_structures:
+                self.structures.apply(event)
+            m.root_path = path
+        elif kind == "start":
+            if path == m.root_path or m.root_path is None:
+                m.root_path = path
+                m.runs += 1
+                m.status, m.outcome, m.ended_with_error = INCOMPLETE, None, None
+            m.leave_all(path, t)
+            m.sync(path, list(event.get("active") or []), t)
+        elif kind == "transition":
+            frm = event.get("from")
+            key = (path, str(frm), str(event.get("outcome")), event.get("to"))
+            m.transitions[key] = m.transitions.get(key, 0) + 1
+            if frm is not None:
+                m.leave(path, frm, t)
+            m.sync(path, list(event.get("active") or []), t)
+        elif kind == "terminate":
+            m.leave_all(path, t)
+            outcome = event.get("outcome")
+            last = event.get("last") or []
+            if outcome is not None and self.structures.container_type(event) != "Concurrence" and last:
+                key = (path, str(last[0]), str(self.structures.state_outcome(event)), str(outcome))
+                m.transitions[key] = m.transitions.get(key, 0) + 1
+            if path == m.root_path:
+                m.outcome = outcome
+                m.status = FINISHED if outcome is not None else ERROR
+                m.ended_with_error = event.get("error")
+        elif kind == "error":
+            m.errors.append({"t": t, "path": path, "state": event.get("state"), "exc_type": event.get("exc_type"),
+                             "message": event.get("message")})
+        elif kind == "preempt":
+            phase = event.get("phase")
+            if phase in m.preempts:
+                m.preempts[phase] += 1
+        elif kind == "feedback":
+            m.feedback += 1
+        elif kind == "control":
+            m.controls.append({k: event.get(k) for k in ("t", "action", "reason", "client", "result")})
+
+    def add_all(self, events: Iterable[dict]) -> Summary:
+        for event in events:
+            self.add(event)
+        return self
+
+    # Results.
+    def exit_code(self) -> int:
+        """0: every machine finished with an outcome; 1: one ended in an error, or never finished."""
+        if not self.machines:
+            return 1
+        return 0 if all(m.status == FINISHED for m in self.machines.values()) else 1
+
+    def to_dict(self) -> dict:
+        machines = {}
+        for name, m in self.machines.items():
+            states = {}
+            for state, visits in m.visits.items():
+                times = m.durations.get(state, [])
+                states[state] = {"visits": visits, "time": {
+                    "total": sum(times), "median": statistics.median(times) if times else None,
+                    "max": max(times) if times else None}}
+            machines[name] = {
+                "status": m.status, "outcome": m.outcome, "error": m.ended_with_error, "runs": m.runs,
+                "events": m.events, "started": m.first_t, "ended": m.last_t,
+                "duration": (m.last_t - m.first_t) if m.first_t is not None and m.last_t is not None else None,
+                "states": states,
+                "transitions": [{"path": p, "from": f, "outcome": o, "to": to, "count": c}
+                                for (p, f, o, to), c in m.transitions.items()],
+                "errors": m.errors, "preempts": dict(m.preempts), "feedback": m.feedback, "controls": m.controls}
+        return {"events": self.events, "machines": machines, "exit_code": self.exit_code(),
+                "problems": [{"line": p.line, "message": p.message} for p in self.problems]}
+
+    def format(self) -> str:
+        data = self.to_dict()
+        out = []
+        if not data["machines"]:
+            out.append("no events")
+        for name, m in data["machines"].items():
+            if m["status"] == FINISHED:
+                head = "finished with outcome '%s'" % m["outcome"]
+            elif m["status"] == ERROR:
+                head = "ended in an error: %s" % (m["error"] or "no outcome")
+            else:
+                head = "did not finish (the log ends while it runs)"
+            duration = "" if m["duration"] is None else " after %.3f s" % m["duration"]
+            out.append("machine %s: %s%s (%d run%s, %d events)"
+                       % (name, head, duration, m["runs"], "" if m["runs"] == 1 else "s", m["events"]))
+            if m["states"]:
+                width = max(len("state"), *(len(s) for s in m["states"]))
+                out.append("  %-*s %7s %10s %10s %10s" % (width, "state", "visits", "total s", "median s", "max s"))
+                for state, info in sorted(m["states"].items()):
+                    tm = info["time"]
+                    out.append("  %-*s %7d %10s %10s %10s" % (width, state, info["visits"], _sec(tm["total"]),
+                                                             _sec(tm["median"]), _sec(tm["max"])))
+            if m["transitions"]:
+                out.append("  transitions taken:")
+                for tr in sorted(m["transitions"], key=lambda tr: (tr["path"], -tr["count"])):
+                    to = "(done)" if tr["to"] is None else tr["to"]
+                    out.append("    %s: %s --%s--> %s  x%d" % (tr["path"], tr["from"], tr["outcome"], to, tr["count"]))
+            if m["preempts"]["requested"] or m["preempts"]["serviced"]:
+                out.append("  preempts: %(requested)d requested, %(serviced)d serviced" % m["preempts"])
+            if m["errors"]:
+                out.append("  errors:")
+                for err in m["errors"]:
+                    state = " in state '%s'" % err["state"] if err["state"] else ""
+                    message = (str(err["message"] or "").strip().splitlines() or [""])[0]
+                    out.append("    %s%s: %s: %s" % (err["path"], state, err["exc_type"], message))
+            else:
+                out.append("  errors: none")
+        if data["problems"]:
+            out.append("%d line%s skipped (see above)" % (len(data["problems"]), "" if len(data["problems"]) == 1 else "s"))
+        return "\n".join(out)
+
+
+def _sec(value: float | None) -> str:
+    return "-" if value is None else "%.4f" % value
+
+
+def summarize(events: Iterable[dict]) -> Summary:
+    return Summary().add_all(events)

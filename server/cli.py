@@ -1,0 +1,143 @@
+"""The ``fsmscope`` command line: one function per subcommand, registered in ``SUBCOMMANDS``.
+
+To add a subcommand, write its argument setup and its handler and register them::
+
+    def _serve_arguments(parser): parser.add_argument("--port", type=int, default=8000)
+
+    @subcommand("serve", "serve the dashboard", _serve_arguments)
+    def serve(args) -> int: ...   # import fastapi/uvicorn here, not at module level
+
+Handlers return the process exit code. Nothing heavy is imported at module import time.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from dataclasses import dataclass
+from typing import Callable
+
+EXIT_OK, EXIT_ERROR, EXIT_UNREADABLE = 0, 1, 2
+
+Handler = Callable[[argparse.Namespace], int]
+
+
+@dataclass
+class Subcommand:
+    name: str
+    help: str
+    arguments: Callable[[argparse.ArgumentParser], None]
+    handler: Handler
+    extra_args: bool = False  # arguments it does not know are left in ``args.extra`` (for a script)
+
+
+SUBCOMMANDS: dict[str, Subcommand] = {}
+
+
+def subcommand(name: str, help: str, arguments: Callable[[argparse.ArgumentParser], None] = lambda p: None,
+               extra_args: bool = False) -> Callable[[Handler], Handler]:
+    def register(handler: Handler) -> Handler:
+        SUBCOMMANDS[name] = Subcommand(name, help, arguments, handler, extra_args)
+        return handler
+    return register
+
+
+# fsmscope run
+
+def _run_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("script", metavar="FILE.py",
+                        help="a SMACH-style script, run as __main__; arguments fsmscope does not know, and "
+                             "all after '--', are passed to it")
+    parser.add_argument("--record", metavar="RUN.jsonl",
+                        help="where to record the events (default: runs/<script>-<timestamp>.jsonl)")
+    parser.add_argument("--no-serve", action="store_true", help="do not serve the dashboard while it runs")
+    parser.add_argument("--exit", action="store_true",
+                        help="exit when the script ends instead of keeping the dashboard up")
+
+
+@subcommand("run", "run a SMACH-style script and record every machine it executes", _run_arguments, extra_args=True)
+def run(args: argparse.Namespace) -> int:
+    from .runner import Runner
+
+    runner = Runner(args.script, list(args.extra), args.record)
+    # The dashboard hooks in here (unless --no-serve): register runner.on_machine callbacks
+    # that attach the hub to each machine, serve while runner.run() executes, and keep
+    # serving afterwards unless --exit.
+    return runner.run()
+
+
+# fsmscope replay
+
+def _replay_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("log", metavar="RUN.jsonl", help="a log written by the recorder")
+    parser.add_argument("--json", action="store_true", help="print only the summary, as JSON")
+    parser.add_argument("--follow", "-f", action="store_true",
+                        help="tail a log still being written, until its writer closes it")
+    parser.add_argument("--no-transcript", action="store_true", help="print only the summary")
+    parser.add_argument("--no-time", action="store_true", help="leave the timestamps out of the transcript")
+
+
+@subcommand("replay", "print a recorded run as SMACH's log lines, then its statistics", _replay_arguments)
+def replay(args: argparse.Namespace) -> int:
+    import json
+
+    from fsm.log_reader import LogError, Reader, follow, read_events
+    from fsm.summary import Summary
+    from fsm.transcript import Transcript
+
+    reader = Reader(args.log, on_problem=lambda p: print("fsmscope replay: %s: skipped %s" % (args.log, p),
+                                                         file=sys.stderr, flush=True))
+    summary = Summary()
+    transcript = Transcript(summary.structures)
+    show = not (args.json or args.no_transcript)
+    out = sys.stdout
+    events = follow(args.log, reader=reader) if args.follow else read_events(args.log, reader=reader)
+    try:
+        for event in events:
+            summary.add(event)
+            if show:
+                for line in transcript.lines(event):
+                    out.write(transcript.format(line, not args.no_time) + "\n")
+                if args.follow:
+                    out.flush()
+    except LogError as exc:
+        print("fsmscope replay: %s" % exc, file=sys.stderr)
+        return EXIT_UNREADABLE
+    except KeyboardInterrupt:
+        pass
+    summary.problems = reader.problems
+    if args.json:
+        data = summary.to_dict()
+        data["file"] = args.log
+        out.write(json.dumps(data, indent=2) + "\n")
+    else:
+        if show:
+            out.write("\n")
+        out.write(summary.format() + "\n")
+    return summary.exit_code()
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="fsmscope", description="Run, watch, record and replay SMACH-style state machines.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    commands.required = True
+    for sub in SUBCOMMANDS.values():
+        sub.arguments(commands.add_parser(sub.name, help=sub.help, description=sub.help))
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra and not SUBCOMMANDS[args.command].extra_args:
+        parser.error("unrecognized arguments: %s" % " ".join(extra))
+    args.extra = extra
+    try:
+        return SUBCOMMANDS[args.command].handler(args)
+    except BrokenPipeError:  # `fsmscope replay run.jsonl | head`
+        sys.stderr.close()
+        return EXIT_OK
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,140 @@
+"""``fsmscope run``: run a user's SMACH-style script as ``__main__`` and record every machine it runs.
+
+The script does not know: a global introspection hook attaches a Recorder to each
+top-level machine the first time it starts, naming it after the script (``foo_bar``,
+then ``foo_bar#2`` for a second machine). Whoever serves a dashboard registers
+``on_machine`` callbacks to attach its own observers to the same machines (they run in
+the machine's thread, before its first event).
+"""
+
+from __future__ import annotations
+
+import os
+import runpy
+import signal
+import sys
+import threading
+import time
+import traceback
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import fsm
+from fsm.introspection import reporter_of
+from fsm.recorder import Recorder
+
+MachineCallback = Callable[[str, Any], None]
+
+
+def default_record_path(script: str, directory: str = "runs") -> str:
+    stem = os.path.splitext(os.path.basename(script))[0]
+    return os.path.join(directory, "%s-%s.jsonl" % (stem, time.strftime("%Y%m%d-%H%M%S")))
+
+
+@dataclass
+class Machine:
+    name: str
+    container: Any
+
+
+@dataclass
+class Runner:
+    """Runs one script with recording; ``run()`` returns its exit code (as ``python script.py`` would)."""
+
+    script: str
+    args: list[str] = field(default_factory=list)
+    record: str | None = None  # path of the log; None: runs/<script>-<timestamp>.jsonl
+    on_machine: list[MachineCallback] = field(default_factory=list)
+    machines: list[Machine] = field(default_factory=list)
+    recorder: Recorder | None = None
+
+    def __post_init__(self) -> None:
+        self.stem = os.path.splitext(os.path.basename(self.script))[0]
+        self.record_path = self.record or default_record_path(self.script)
+        self._lock = threading.Lock()
+
+    def _hook(self, container: Any) -> None:
+        with self._lock:
+            if any(m.container is container for m in self.machines):
+                return
+            name = self.stem if not self.machines else "%s#%d" % (self.stem, len(self.machines) + 1)
+            rep = reporter_of(container)
+            if rep is not None:  # the script attached it itself: keep the name it chose
+                name = rep.machine
+            machine = Machine(name, container)
+            self.machines.append(machine)
+        fsm.attach(container, self.recorder, name=name)
+        for callback in list(self.on_machine):
+            try:
+                callback(name, container)
+            except Exception:
+                sys.stderr.write("fsmscope: an on_machine callback failed:\n" + traceback.format_exc())
+
+    def run(self) -> int:
+        script = os.path.abspath(self.script)
+        if not os.path.isfile(script):
+            sys.stderr.write("fsmscope run: %s: no such file\n" % self.script)
+            return 2
+        self.recorder = Recorder(self.record_path)
+        sys.stderr.write("fsmscope: recording to %s\n" % self.record_path)
+        saved_argv, saved_path0 = sys.argv, sys.path[0] if sys.path else None
+        sys.argv = [self.script] + list(self.args)
+        if sys.path:
+            sys.path[0] = os.path.dirname(script)
+        else:
+            sys.path.insert(0, os.path.dirname(script))
+        restore_sigterm = _sigterm_as_exit()
+        fsm.add_global_hook(self._hook)
+        code = 0
+        try:
+            runpy.run_path(script, run_name="__main__")
+        except SystemExit as exc:
+            code = _exit_code(exc.code)
+        except KeyboardInterrupt:
+            code = 130
+        except BaseException:
+            traceback.print_exc()
+            code = 1
+        finally:
+            fsm.remove_global_hook(self._hook)
+            restore_sigterm()
+            sys.argv = saved_argv
+            if saved_path0 is not None and sys.path:
+                sys.path[0] = saved_path0
+            self.recorder.close()
+            names = ", ".join(m.name for m in self.machines) or "no machine"
+            sys.stderr.write("fsmscope: recorded %d events (%s) to %s\n"
+                             % (self.recorder.events, names, self.record_path))
+        return code
+
+
+def _exit_code(code: Any) -> int:
+    if code is None:
+        return 0
+    if isinstance(code, int):
+        return code
+    sys.stderr.write("%s\n" % code)
+    return 1
+
+
+def _sigterm_as_exit() -> Callable[[], None]:
+    """Turn SIGTERM into SystemExit (so the log is closed) unless the script handles it itself."""
+    if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
+        return lambda: None
+
+    def on_sigterm(signum: int, frame: Any) -> None:
+        raise SystemExit(128 + signum)
+
+    signal.signal(signal.SIGTERM, on_sigterm)
+
+    def restore() -> None:
+        if signal.getsignal(signal.SIGTERM) is on_sigterm:
+            signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    return restore
+
+
+def run_script(script: str, args: list[str] | None = None, record: str | None = None,
+               on_machine: list[MachineCallback] | None = None) -> tuple[int, Runner]:
+    """Run ``script`` with recording; returns (exit code, the Runner with its machines and log path)."""
+    runner = Runner(script, list(args or []), record, list(on_machine or []))
+    return runner.run(), runner

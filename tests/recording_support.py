@@ -1,0 +1,36 @@
+"""Helpers shared by the recording, replay, CLI and example tests."""
+
+import os
+import runpy
+import subprocess
+import sys
+
+import fsm
+from fsm.recorder import Recorder
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+EXAMPLES = os.path.join(ROOT, "examples")
+FAST = {"FSMSCOPE_TIME_SCALE": "0.01"}
+
+
+def load_example(name: str) -> dict:
+    """The example's module globals (its ``__main__`` block does not run)."""
+    return runpy.run_path(os.path.join(EXAMPLES, name + ".py"), run_name="example_" + name)
+
+
+def record(sm, path, name: str = "m", **recorder_kwargs):
+    """Run ``sm`` once with a Recorder on ``path``; returns (outcome, the events it was given)."""
+    seen = []
+    with Recorder(path, **recorder_kwargs) as recorder:
+        fsm.attach(sm, recorder, name=name)
+        fsm.attach(sm, seen.append)
+        outcome = sm.execute()
+    return outcome, seen
+
+
+def cli(*args, cwd=None, env=None, timeout=60):
+    """``fsmscope ARGS`` in a real process; returns the CompletedProcess (text)."""
+    full_env = dict(os.environ, **(env or {}))
+    full_env["PYTHONPATH"] = ROOT + os.pathsep + full_env.get("PYTHONPATH", "")
+    return subprocess.run([sys.executable, "-m", "server.cli", *map(str, args)], cwd=cwd or ROOT, env=full_env,
+                          capture_output=True, text=True, timeout=timeout)

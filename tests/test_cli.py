@@ -1,0 +1,124 @@
+"""The fsmscope command line, in real processes: run, replay and their exit codes."""
+
+import json
+import os
+import subprocess
+import sys
+import time
+
+import pytest
+from fsm.encoding import dumps
+
+from recording_support import EXAMPLES, FAST, ROOT, cli
+
+
+@pytest.fixture(scope="module")
+def foo_bar_log(tmp_path_factory):
+    path = tmp_path_factory.mktemp("cli") / "foo_bar.jsonl"
+    done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--record", path)
+    assert done.returncode == 0, done.stderr
+    return path
+
+
+def test_run_records_to_the_given_path_and_says_where(foo_bar_log):
+    assert foo_bar_log.exists() and os.path.exists(str(foo_bar_log) + ".idx")
+
+
+def test_run_records_under_runs_by_default_and_prints_the_path(tmp_path):
+    done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), cwd=tmp_path)
+    assert done.returncode == 0
+    logs = list((tmp_path / "runs").glob("foo_bar-*.jsonl"))
+    assert len(logs) == 1
+    assert os.path.join("runs", logs[0].name) in done.stderr
+
+
+def test_run_passes_unknown_arguments_to_the_script(tmp_path):
+    done = cli("run", os.path.join(EXAMPLES, "retry_abc.py"), "--seed", "7", "--record", tmp_path / "a.jsonl")
+    again = cli("run", os.path.join(EXAMPLES, "retry_abc.py"), "--seed", "7", "--record", tmp_path / "b.jsonl")
+    counts = [line for line in done.stdout.splitlines() if line.startswith("A_count=")]
+    assert counts and counts == [line for line in again.stdout.splitlines() if line.startswith("A_count=")]
+
+
+def test_run_names_a_second_machine_after_the_script_with_a_number(tmp_path):
+    script = tmp_path / "twice.py"
+    script.write_text("import runpy, sys\nsys.path.insert(0, %r)\nfrom foo_bar import build\n"
+                      "build().execute()\nbuild().execute()\n" % EXAMPLES)
+    log = tmp_path / "twice.jsonl"
+    assert cli("run", script, "--record", log).returncode == 0
+    summary = json.loads(cli("replay", log, "--json").stdout)
+    assert list(summary["machines"]) == ["twice", "twice#2"]
+
+
+def test_run_accepts_no_serve_and_exit(tmp_path):
+    done = cli("run", "--no-serve", "--exit", os.path.join(EXAMPLES, "foo_bar.py"), "--record", tmp_path / "r.jsonl")
+    assert done.returncode == 0
+
+
+def test_run_returns_the_script_exit_code(tmp_path):
+    script = tmp_path / "fails.py"
+    script.write_text("raise SystemExit(3)\n")
+    assert cli("run", script, "--record", tmp_path / "r.jsonl").returncode == 3
+
+
+def test_replay_prints_the_transcript_then_the_summary_and_exits_0(foo_bar_log):
+    done = cli("replay", foo_bar_log)
+    assert done.returncode == 0
+    assert "/SM_ROOT [  INFO ] : State machine terminating 'FOO':'outcome2':'end'" in done.stdout
+    assert "machine foo_bar: finished with outcome 'end'" in done.stdout
+
+
+def test_replay_json_gives_the_summary_as_json(foo_bar_log):
+    done = cli("replay", foo_bar_log, "--json")
+    data = json.loads(done.stdout)
+    assert data["exit_code"] == 0 and data["machines"]["foo_bar"]["outcome"] == "end"
+
+
+def test_replay_exits_1_when_the_machine_ended_in_an_error(tmp_path):
+    script = tmp_path / "bad.py"
+    script.write_text("import fsm as smach\n"
+                      "sm = smach.StateMachine(['done'])\n"
+                      "with sm:\n"
+                      "    smach.StateMachine.add('BAD', smach.CBState(lambda ud: 1 / 0, outcomes=['done']), {})\n"
+                      "sm.execute()\n")
+    log = tmp_path / "bad.jsonl"
+    assert cli("run", script, "--record", log).returncode == 1
+    done = cli("replay", log)
+    assert done.returncode == 1
+    assert "InvalidUserCodeError" in done.stdout
+
+
+def test_replay_of_a_missing_file_is_a_one_line_error_with_exit_2(tmp_path):
+    done = cli("replay", tmp_path / "missing.jsonl")
+    assert done.returncode == 2
+    assert done.stderr.strip().count("\n") == 0 and "no such file" in done.stderr
+
+
+def test_replay_refuses_an_unknown_schema_version_with_exit_2(tmp_path):
+    log = tmp_path / "future.jsonl"
+    log.write_bytes(dumps({"v": 99, "seq": 1, "t": 0, "run": "r", "machine": "m", "kind": "start", "path": "/"}) + b"\n")
+    done = cli("replay", log)
+    assert done.returncode == 2 and "schema version 99 is not supported" in done.stderr
+
+
+def test_replay_reports_a_truncated_last_line_and_replays_the_rest(foo_bar_log, tmp_path):
+    data = foo_bar_log.read_bytes()
+    cut = tmp_path / "cut.jsonl"
+    cut.write_bytes(data[:-10])
+    n_lines = data.count(b"\n")
+    done = cli("replay", cut)
+    assert "line %d: truncated last line" % n_lines in done.stderr
+    assert "State machine transitioning 'BAR':'outcome1'-->'FOO'" in done.stdout
+    assert done.returncode == 1  # the terminate event was the line cut short
+
+
+def test_replay_follow_tails_a_log_until_its_writer_closes_it(tmp_path):
+    log = tmp_path / "live.jsonl"
+    env = dict(os.environ, FSMSCOPE_TIME_SCALE="0.05", PYTHONPATH=ROOT)
+    writer = subprocess.Popen([sys.executable, "-m", "server.cli", "run", os.path.join(EXAMPLES, "nested_monitor.py"),
+                               "--record", str(log)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        done = cli("replay", "--follow", log, timeout=30)
+    finally:
+        writer.wait(30)
+    assert done.returncode == 0, done.stderr
+    assert "machine nested_monitor: finished with outcome 'preempted'" in done.stdout

@@ -1,0 +1,77 @@
+"""fsm.summary: outcome, visits and time per state, transitions taken, errors, exit codes."""
+
+import pytest
+from fsm.log_reader import read_events
+from fsm.summary import ERROR, FINISHED, INCOMPLETE, summarize
+
+from recording_support import load_example, record
+from smach_support import Out, machine
+
+
+def _ev(seq, t, kind, path="/SM_ROOT", **fields):
+    return dict({"v": 1, "seq": seq, "t": t, "run": "r", "machine": "m", "kind": kind, "path": path}, **fields)
+
+
+STRUCTURE = {"label": "SM_ROOT", "path": "/SM_ROOT", "type": "StateMachine", "container": True, "outcomes": ["done"],
+             "initial": ["A"], "children": [], "transitions": [{"from": "A", "outcome": "go", "to": "B"},
+                                                              {"from": "B", "outcome": "ok", "to": "done"}]}
+
+
+def _timed_run():
+    """A for 1 s, B for 2 s, A for 3 s, B for 0.5 s, then 'done'."""
+    return [_ev(1, 0.0, "structure", root=STRUCTURE),
+            _ev(2, 0.0, "start", initial=["A"], active=["A"], userdata={}),
+            _ev(3, 1.0, "transition", **{"from": "A", "outcome": "go", "to": "B", "active": ["B"]}),
+            _ev(4, 3.0, "transition", **{"from": "B", "outcome": "back", "to": "A", "active": ["A"]}),
+            _ev(5, 6.0, "transition", **{"from": "A", "outcome": "go", "to": "B", "active": ["B"]}),
+            _ev(6, 6.5, "terminate", last=["B"], outcome="done", active=[])]
+
+
+def test_foo_bar_counts_visits_and_transitions(tmp_path):
+    path = tmp_path / "run.jsonl"
+    record(load_example("foo_bar")["build"](), path)
+    m = summarize(read_events(path)).to_dict()["machines"]["m"]
+    assert (m["status"], m["outcome"], m["runs"]) == (FINISHED, "end", 1)
+    assert {s: v["visits"] for s, v in m["states"].items()} == {"/SM_ROOT/FOO": 4, "/SM_ROOT/BAR": 3}
+    assert {(t["from"], t["outcome"], t["to"]): t["count"] for t in m["transitions"]} == {
+        ("FOO", "outcome1", "BAR"): 3, ("BAR", "outcome1", "FOO"): 3, ("FOO", "outcome2", "end"): 1}
+
+
+def test_time_in_state_has_total_median_and_max():
+    states = summarize(_timed_run()).to_dict()["machines"]["m"]["states"]
+    assert states["/SM_ROOT/A"] == {"visits": 2, "time": {"total": 4.0, "median": 2.0, "max": 3.0}}
+    assert states["/SM_ROOT/B"] == {"visits": 2, "time": {"total": 2.5, "median": 1.25, "max": 2.0}}
+
+
+def test_a_finished_run_exits_0():
+    assert summarize(_timed_run()).exit_code() == 0
+
+
+def test_a_log_that_ends_mid_run_is_incomplete_and_exits_1():
+    summary = summarize(_timed_run()[:-1])
+    assert summary.to_dict()["machines"]["m"]["status"] == INCOMPLETE
+    assert summary.exit_code() == 1
+
+
+def test_a_run_ending_in_an_error_lists_it_and_exits_1(tmp_path):
+    path = tmp_path / "run.jsonl"
+
+    def boom(ud):
+        raise ValueError("boom")
+    with pytest.raises(Exception):
+        record(machine(["done"], [("BAD", Out(boom, outcomes=["done"]), {})]), path)
+    summary = summarize(read_events(path))
+    m = summary.to_dict()["machines"]["m"]
+    assert m["status"] == ERROR and m["outcome"] is None
+    assert [(e["state"], e["exc_type"]) for e in m["errors"]] == [("BAD", "InvalidUserCodeError")]
+    assert summary.exit_code() == 1
+
+
+def test_an_empty_log_exits_1():
+    assert summarize([]).exit_code() == 1
+
+
+def test_the_text_summary_names_outcome_states_and_transitions():
+    text = summarize(_timed_run()).format()
+    assert "machine m: finished with outcome 'done'" in text
+    assert "/SM_ROOT/A" in text and "A --go--> B  x2" in text and "errors: none" in text

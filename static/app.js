@@ -23,6 +23,7 @@ const app = {
   lastEdge: new Map(), // container path -> e: id of its last transition
   expand: null, // null: the server's default; else a Set of container paths drawn open
   preemptAsked: false,
+  finishedText: null, // "NAME finished: outcome 'X'" once the root terminated, until it starts again
   renderQueued: false,
   online: true,
 };
@@ -183,6 +184,7 @@ function track(ev) {
   const path = ev.path;
   switch (ev.kind) {
     case "start":
+      if (path === app.status.root_path) app.finishedText = null;
       app.pendingChanges.set(path, new Set());
       app.changed.set(path, new Set());
       app.lastEdge.delete(path);
@@ -211,7 +213,8 @@ function track(ev) {
       }
       if (path === app.status.root_path) {
         const outcome = ev.outcome === null ? "no outcome" + (ev.error ? ` (${ev.error})` : "") : `outcome '${ev.outcome}'`;
-        notice(`${app.name} finished: ${outcome}`, ev.outcome === null ? "error" : app.preemptAsked ? "warn" : "ok", true);
+        app.finishedText = `${app.name} finished: ${outcome}`;
+        notice(app.finishedText, ev.outcome === null ? "error" : app.preemptAsked ? "warn" : "ok", true);
         app.preemptAsked = false;
       }
       break;
@@ -361,11 +364,16 @@ $("preempt-btn").addEventListener("click", async () => {
   const name = app.name;
   const answer = await confirmPreempt(name);
   if (!answer) return;
+  app.preemptAsked = true;
+  app.finishedText = null;
   try {
     const ack = await api.preempt(name, answer.reason);
-    app.preemptAsked = true;
-    notice(`Preempt accepted (event ${ack.seq}): waiting for the outcome…`, "warn", true);
+    if (name !== app.name) return;
+    // The outcome may have arrived on the stream before this answer did.
+    notice(`Preempt accepted (event ${ack.seq}): ` + (app.finishedText || "waiting for the outcome…"),
+      "warn", true);
   } catch (err) {
+    app.preemptAsked = false;
     notice("Preempt failed: " + (err.detail || err.message), "error", true);
   }
 });

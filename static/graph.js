@@ -26,6 +26,11 @@ export function sanitizeSvg(root) {
     }
   }
   for (const el of doomed) el.remove();
+  // Graphviz prefixes ids with "pageX,Y_" when it paginates; the contract's ids are without.
+  for (const el of root.querySelectorAll("[id]")) {
+    const m = /^page\d+,\d+_([scoe]:.*)$/s.exec(el.id);
+    if (m) el.id = m[1];
+  }
   return root;
 }
 
@@ -173,7 +178,8 @@ export class GraphView {
     const box = el.getBoundingClientRect();
     const view = this.host.getBoundingClientRect();
     if (!view.width || !view.height) return;
-    const margin = 24;
+    const margin = 2;
+    if (box.width > view.width - 2 * margin || box.height > view.height - 2 * margin) return;
     const inside = box.left >= view.left + margin && box.right <= view.right - margin
       && box.top >= view.top + margin && box.bottom <= view.bottom - margin;
     if (inside) return;

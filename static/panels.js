@@ -247,7 +247,7 @@ export class EventLog {
       h("span", { class: "seq", text: String(ev.seq) }),
       h("span", { class: "time", text: clock(ev.t) }),
       h("span", { class: "kind", text: ev.kind }),
-      h("span", { class: "path", text: ev.path, title: ev.path }),
+      h("span", { class: "path", title: ev.path }, h("bdi", { text: ev.path })),
       h("span", { class: "msg", text: line.text, title: ev.kind === "error" && ev.traceback ? ev.traceback : line.text }));
   }
 

@@ -1,0 +1,301 @@
+"""A machine's graph as SVG: each container laid out on its own by Graphviz dot, composed bottom-up.
+
+Laying out a whole hierarchy as one graph explodes (1,000 states took minutes); here every
+open container is a graph of its own in which a child container is one node: a plain box
+when closed, a fixed-size box the size of the child's finished drawing when open. The
+child's drawing is then put in that box's place. Graphs are built with pydot's API (never
+by parsing DOT); all containers of one depth go to one ``dot`` process. Ids follow
+docs/api.md: ``s:PATH`` (state), ``o:PATH:OUTCOME`` (container outcome),
+``e:PATH:FROM:OUTCOME`` (edge), ``c:PATH`` (open container).
+
+Results are cached per (structure hash, set of open containers); a composed container is
+also cached on its own, so opening one more container lays out only it and its ancestors.
+"""
+
+from __future__ import annotations
+
+import collections
+import concurrent.futures
+import os
+import shutil
+import subprocess
+import threading
+import xml.etree.ElementTree as ET
+from typing import Iterable
+
+import pydot
+
+SVG_NS = "http://www.w3.org/2000/svg"
+XLINK_NS = "http://www.w3.org/1999/xlink"
+ET.register_namespace("", SVG_NS)
+ET.register_namespace("xlink", XLINK_NS)
+_G = "{%s}g" % SVG_NS
+_POLYGON = "{%s}polygon" % SVG_NS
+
+AUTO_OPEN_LIMIT = 150   # without ``expand``: every container open up to this many states, else only the root
+DOT_TIMEOUT = 60.0
+BIG_CONTAINER = 40      # children above which edges are straight lines with external labels
+
+
+class GraphError(Exception):
+    """Graphviz failed or is missing."""
+
+
+def q(text: str) -> str:
+    """A DOT double-quoted string: never an HTML label, no escape sequences of dot's own."""
+    return '"%s"' % str(text).replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+
+
+def containers(node: dict) -> Iterable[dict]:
+    if node.get("container"):
+        yield node
+        for child in node.get("children") or ():
+            yield from containers(child)
+
+
+def _count(node: dict) -> int:
+    return 1 + sum(_count(c) for c in node.get("children") or ())
+
+
+def open_set(root: dict, expand: Iterable[str] | None, n_states: int) -> frozenset[str]:
+    """The containers drawn open: the root, and those named (whose parents are open too)."""
+    if not expand:
+        if n_states <= AUTO_OPEN_LIMIT:
+            return frozenset(c["path"] for c in containers(root))
+        return frozenset([root["path"]])
+    wanted = set(expand) | {root["path"]}
+    visible: set[str] = set()
+
+    def walk(node: dict) -> None:
+        if node.get("container") and node["path"] in wanted:
+            visible.add(node["path"])
+            for child in node.get("children") or ():
+                walk(child)
+    walk(root)
+    return frozenset(visible)
+
+
+def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
+    """One container's graph; ``sizes`` gives the drawing size (points) of each open child container."""
+    path = node["path"]
+    g = pydot.Dot(q(path), graph_type="digraph")
+    g.set("id", q("c:" + path))
+    g.set("label", q(node["label"] + " (" + node.get("type", "") + ")"))
+    g.set("labelloc", "t")
+    g.set("fontsize", "12")
+    g.set("nodesep", "0.3")
+    g.set("ranksep", "0.4")
+    g.set_node_defaults(fontsize="11", shape="box", style="rounded")
+    g.set_edge_defaults(fontsize="9")
+    big = len(node.get("children") or ()) > BIG_CONTAINER
+    if big:  # dot's spline routing and label placement grow fast with long edges: keep big graphs cheap
+        g.set("splines", "line")
+    names: dict[str, str] = {}
+    for i, child in enumerate(node.get("children") or ()):
+        name = "n%d" % i
+        names[child["label"]] = name
+        cpath = child["path"]
+        if cpath in sizes:
+            w, h = sizes[cpath]
+            g.add_node(pydot.Node(name, id=q("s:" + cpath), label=q(""), shape="box", style="solid", color="transparent",
+                                  fixedsize="true", width="%.4f" % (w / 72.0), height="%.4f" % (h / 72.0)))
+        elif child.get("container"):
+            g.add_node(pydot.Node(name, id=q("s:" + cpath), label=q(child["label"]), shape="box3d", style="solid",
+                                  **{"class": q("container")}))
+        else:
+            g.add_node(pydot.Node(name, id=q("s:" + cpath), label=q(child["label"]), **{"class": q("state")}))
+    outcome_nodes: dict[str, str] = {}
+
+    def outcome_node(outcome: str) -> str:
+        name = outcome_nodes.get(outcome)
+        if name is None:
+            name = outcome_nodes[outcome] = "o%d" % len(outcome_nodes)
+            g.add_node(pydot.Node(name, id=q("o:%s:%s" % (path, outcome)), label=q(outcome), shape="ellipse",
+                                  style="filled", fillcolor="lightgrey", **{"class": q("outcome")}))
+        return name
+
+    for outcome in node.get("outcomes") or ():
+        outcome_node(outcome)
+    outcome_set = set(outcome_nodes.values())
+    seen: dict[str, int] = {}
+    for tr in node.get("transitions") or ():
+        src = names.get(tr["from"])
+        if src is None:
+            continue
+        target = tr.get("to")
+        if target is None:
+            target = tr["outcome"]
+        dst = names.get(target)
+        if dst is None:
+            dst = outcome_node(target)
+            outcome_set.add(dst)
+        edge_id = "e:%s:%s:%s" % (path, tr["from"], tr["outcome"])
+        n = seen.get(edge_id, 0)
+        seen[edge_id] = n + 1
+        if n:
+            edge_id += ":%d" % (n + 1)
+        attrs = {"id": q(edge_id), ("xlabel" if big else "label"): q(tr["outcome"])}
+        if dst in outcome_set:  # edges into outcomes do not rank: many long edges to one sink explode dot
+            attrs["constraint"] = "false"
+        g.add_edge(pydot.Edge(src, dst, **attrs))
+    if outcome_nodes:
+        sink = pydot.Subgraph(rank="sink")
+        for name in outcome_nodes.values():
+            sink.add_node(pydot.Node(name))
+        g.add_subgraph(sink)
+    return g
+
+
+def run_dot(graphs: list[pydot.Dot]) -> list[ET.Element]:
+    """Lay out several graphs with one dot process; returns each one's <svg> element, in order."""
+    dot = shutil.which("dot")
+    if dot is None:
+        raise GraphError("Graphviz 'dot' is not installed")
+    text = "\n".join(g.to_string() for g in graphs).encode()
+    try:
+        proc = subprocess.run([dot, "-Tsvg"], input=text, capture_output=True, timeout=DOT_TIMEOUT)
+    except subprocess.TimeoutExpired as exc:
+        raise GraphError("dot took longer than %.0f s" % DOT_TIMEOUT) from exc
+    if proc.returncode != 0:
+        raise GraphError("dot failed: %s" % proc.stderr.decode(errors="replace")[:500])
+    docs = proc.stdout.split(b"<?xml")[1:]
+    if len(docs) != len(graphs):
+        raise GraphError("dot returned %d drawings for %d graphs" % (len(docs), len(graphs)))
+    return [ET.fromstring(b"<?xml" + doc) for doc in docs]
+
+
+def run_dot_parallel(graphs: list[pydot.Dot]) -> list[ET.Element]:
+    """``run_dot`` split over one dot process per core when there are many graphs."""
+    workers = min(os.cpu_count() or 1, 8, max(1, len(graphs) // 8))
+    if workers <= 1:
+        return run_dot(graphs)
+    chunks = [graphs[i::workers] for i in range(workers)]
+    with concurrent.futures.ThreadPoolExecutor(workers) as pool:
+        results = list(pool.map(run_dot, chunks))
+    out: list[ET.Element] = [None] * len(graphs)  # type: ignore[list-item]
+    for i, result in enumerate(results):
+        out[i::workers] = result
+    return out
+
+
+def _size(svg: ET.Element) -> tuple[float, float]:
+    box = svg.get("viewBox", "0 0 0 0").split()
+    return float(box[2]), float(box[3])
+
+
+def _bbox(g: ET.Element) -> tuple[float, float] | None:
+    poly = g.find(_POLYGON)
+    if poly is None:
+        return None
+    xs, ys = [], []
+    for pair in poly.get("points", "").split():
+        x, _, y = pair.partition(",")
+        xs.append(float(x))
+        ys.append(float(y))
+    return (min(xs), min(ys)) if xs else None
+
+
+class Renderer:
+    """Cached, thread-safe rendering of structures to SVG."""
+
+    def __init__(self, max_docs: int = 64, max_parts: int = 4096) -> None:
+        self._lock = threading.Lock()
+        self._docs: collections.OrderedDict[tuple, bytes] = collections.OrderedDict()
+        self._parts: collections.OrderedDict[tuple, tuple[ET.Element, float, float]] = collections.OrderedDict()
+        self._max_docs = max_docs
+        self._max_parts = max_parts
+        self.layouts = 0  # containers laid out by dot so far (for tests and benchmarks)
+
+    def render(self, root: dict, key: str, expand: Iterable[str] | None = None, n_states: int | None = None) -> bytes:
+        if n_states is None:
+            n_states = _count(root)
+        opened = open_set(root, expand, n_states)
+        doc_key = (key, opened)
+        with self._lock:
+            doc = self._docs.get(doc_key)
+            if doc is not None:
+                self._docs.move_to_end(doc_key)
+                return doc
+            doc = self._render(root, key, opened)
+            self._docs[doc_key] = doc
+            while len(self._docs) > self._max_docs:
+                self._docs.popitem(last=False)
+            return doc
+
+    def _part_key(self, key: str, node: dict, opened: frozenset[str]) -> tuple:
+        prefix = node["path"] + "/"
+        return (key, node["path"], frozenset(p for p in opened if p.startswith(prefix)))
+
+    def _render(self, root: dict, key: str, opened: frozenset[str]) -> bytes:
+        by_depth: dict[int, list[dict]] = collections.defaultdict(list)
+
+        def walk(node: dict, depth: int) -> None:
+            if node["path"] in opened:
+                by_depth[depth].append(node)
+                for child in node.get("children") or ():
+                    if child.get("container"):
+                        walk(child, depth + 1)
+        walk(root, 0)
+        done: dict[str, tuple[ET.Element, float, float]] = {}
+        for depth in sorted(by_depth, reverse=True):
+            todo = []
+            for node in by_depth[depth]:
+                pkey = self._part_key(key, node, opened)
+                part = self._parts.get(pkey)
+                if part is not None:
+                    self._parts.move_to_end(pkey)
+                    done[node["path"]] = part
+                else:
+                    todo.append((node, pkey))
+            if not todo:
+                continue
+            graphs = []
+            for node, _ in todo:
+                sizes = {c["path"]: done[c["path"]][1:] for c in node.get("children") or () if c["path"] in done}
+                graphs.append(build_dot(node, sizes))
+            svgs = run_dot_parallel(graphs)
+            self.layouts += len(todo)
+            for (node, pkey), svg in zip(todo, svgs):
+                part = self._compose(node, svg, done)
+                done[node["path"]] = part
+                self._parts[pkey] = part
+            while len(self._parts) > self._max_parts:
+                self._parts.popitem(last=False)
+        group, w, h = done[root["path"]]
+        svg = ET.Element("{%s}svg" % SVG_NS, {"width": "%gpt" % w, "height": "%gpt" % h,
+                                               "viewBox": "0 0 %g %g" % (w, h), "class": "fsm-graph"})
+        svg.append(group)
+        return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(svg)
+
+    @staticmethod
+    def _compose(node: dict, svg: ET.Element, done: dict) -> tuple[ET.Element, float, float]:
+        """The container's drawing with each open child's drawing put in its placeholder's place."""
+        group = svg.find(_G)
+        if group is None:
+            raise GraphError("dot produced no graph for %s" % node["path"])
+        group.set("class", "cluster")
+        frame = group.find(_POLYGON)
+        if frame is not None:
+            frame.set("class", "frame")
+            frame.set("stroke", "#999999")
+        for i, child in enumerate(list(group)):
+            cid = child.get("id", "")
+            if child.tag != _G or not cid.startswith("s:") or cid[2:] not in done:
+                continue
+            corner = _bbox(child)
+            if corner is None:
+                continue
+            inner = done[cid[2:]][0]
+            wrapper = ET.Element(_G, {"transform": "translate(%g %g)" % corner})
+            wrapper.append(inner)
+            group[i] = wrapper
+        w, h = _size(svg)
+        return group, w, h
+
+
+_default = Renderer()
+
+
+def render(root: dict, key: str, expand: Iterable[str] | None = None, n_states: int | None = None) -> bytes:
+    """The SVG of a structure (``key`` identifies it, e.g. its hash) with the given containers open."""
+    return _default.render(root, key, expand, n_states)

@@ -53,6 +53,8 @@ def _run_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-serve", action="store_true", help="do not serve the dashboard while it runs")
     parser.add_argument("--exit", action="store_true",
                         help="exit when the script ends instead of keeping the dashboard up")
+    from .serve import add_server_arguments
+    add_server_arguments(parser, 0)
 
 
 @subcommand("run", "run a SMACH-style script and record every machine it executes", _run_arguments, extra_args=True)
@@ -60,10 +62,24 @@ def run(args: argparse.Namespace) -> int:
     from .runner import Runner
 
     runner = Runner(args.script, list(args.extra), args.record)
-    # The dashboard hooks in here (unless --no-serve): register runner.on_machine callbacks
-    # that attach the hub to each machine, serve while runner.run() executes, and keep
-    # serving afterwards unless --exit.
-    return runner.run()
+    if args.no_serve:
+        return runner.run()
+    from .serve import run_with_dashboard
+    return run_with_dashboard(args, runner)
+
+
+# fsmscope serve
+
+def _serve_arguments(parser: argparse.ArgumentParser) -> None:
+    from .serve import DEFAULT_PORT, add_server_arguments
+    add_server_arguments(parser, DEFAULT_PORT)
+
+
+@subcommand("serve", "serve the dashboard for machines of other processes (they publish to /api/ingest)",
+            _serve_arguments)
+def serve(args: argparse.Namespace) -> int:
+    from .serve import serve as serve_main
+    return serve_main(args)
 
 
 # fsmscope replay

@@ -1,0 +1,114 @@
+"""Helpers for the server tests: small machines, an authenticated HTTP client, websocket frames."""
+
+import json
+import threading
+import time
+
+import fsm
+import httpx
+from websockets.sync.client import connect
+
+
+def sleeper(seconds=0.0, outcome="go"):
+    def cb(ud):
+        time.sleep(seconds)
+        return outcome
+    return fsm.CBState(cb, outcomes=[outcome])
+
+
+def two_state_machine(delay=0.0):
+    """FOO -go-> BAR -go-> done; each state sleeps ``delay`` and counts its visits in userdata."""
+    sm = fsm.StateMachine(outcomes=["done"])
+    sm.userdata.visits = []
+
+    def visit(label):
+        def cb(ud):
+            time.sleep(delay)
+            ud.visits = ud.visits + [label]
+            return "go"
+        return fsm.CBState(cb, outcomes=["go"], input_keys=["visits"], output_keys=["visits"])
+
+    with sm:
+        fsm.StateMachine.add("FOO", visit("FOO"), {"go": "BAR"})
+        fsm.StateMachine.add("BAR", visit("BAR"), {"go": "done"})
+    return sm
+
+
+class Waiting(fsm.State):
+    """Waits until preempted (then 'preempted') or until ``release`` is set (then 'done')."""
+
+    def __init__(self):
+        fsm.State.__init__(self, outcomes=["done", "preempted"])
+        self.entered = threading.Event()
+        self.release = threading.Event()
+
+    def execute(self, ud):
+        self.entered.set()
+        while not self.release.is_set():
+            if self.preempt_requested():
+                self.service_preempt()
+                return "preempted"
+            time.sleep(0.005)
+        return "done"
+
+
+def waiting_machine():
+    sm = fsm.StateMachine(outcomes=["done", "preempted"])
+    wait = Waiting()
+    with sm:
+        fsm.StateMachine.add("WAIT", wait, {"done": "done", "preempted": "preempted"})
+    return sm, wait
+
+
+def nested_machine():
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        sub = fsm.StateMachine(outcomes=["done"])
+        with sub:
+            fsm.StateMachine.add("A", sleeper(), {"go": "B"})
+            fsm.StateMachine.add("B", sleeper(), {"go": "done"})
+        fsm.StateMachine.add("SUB", sub, {"done": "C"})
+        fsm.StateMachine.add("C", sleeper(), {"go": "done"})
+    return sm
+
+
+def client(srv, token=True):
+    headers = {"Authorization": "Bearer " + srv.token} if token else {}
+    return httpx.Client(base_url=srv.base_url, headers=headers, timeout=10)
+
+
+def stream(srv, name, since=None, token=True, **kw):
+    url = "ws://127.0.0.1:%d/api/machines/%s/stream" % (srv.port, name)
+    params = []
+    if token:
+        params.append("token=" + srv.token)
+    if since is not None:
+        params.append("since=%d" % since)
+    if params:
+        url += "?" + "&".join(params)
+    return connect(url, compression=None, open_timeout=5, **kw)
+
+
+def frames(ws, until, timeout=5.0):
+    """Receive frames until ``until(frames)`` is true; returns the parsed frames."""
+    got = []
+    deadline = time.monotonic() + timeout
+    while not until(got):
+        remaining = deadline - time.monotonic()
+        if remaining <= 0:
+            raise AssertionError("timed out; frames so far: %r" % got[-5:])
+        got.append(json.loads(ws.recv(timeout=remaining)))
+    return got
+
+
+def events_of(frame_list):
+    return [e for f in frame_list if f["type"] == "events" for e in f["events"]]
+
+
+def wait_for(predicate, timeout=5.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return
+        time.sleep(0.005)
+    raise AssertionError("condition not met in %.1f s" % timeout)

@@ -2,7 +2,7 @@
 
 One ``World`` owns one ``MjModel``/``MjData`` pair and the lock that guards them.
 Physics steps in its own thread, either paced to wall-clock time (``speed`` times
-real time) or, with ``fast=True``, on demand: the thread advances simulated time
+real time) or, with ``fast=True`` (``speed`` None), on demand: the thread advances simulated time
 only while someone waits in :meth:`World.sleep`, as fast as it can. On-demand
 stepping makes an episode deterministic for a given seed: the task machine's
 commands land at the same simulated instants whatever the thread scheduling.
@@ -78,11 +78,12 @@ class WorldStopped(RuntimeError):
 class World:
     """Model, data, lock and physics thread of the demo world."""
 
-    def __init__(self, seed: int = 0, fast: bool = False, speed: float = 1.0):
+    def __init__(self, seed: int = 0, fast: bool = False, speed: float | None = 1.0):
         self.model = load_model()
         self.data = mujoco.MjData(self.model)
-        self.fast = fast
-        self.speed = speed
+        self.speed = None if fast else speed  # None: on demand (fast mode)
+        self._anchor: tuple[float, float] | None = None  # (sim time, wall time) of pacing
+        self.label_hooks: list = []  # called with each new label, in the setter's thread
         self.lock = threading.RLock()
         self._cond = threading.Condition(self.lock)
         self._thread: threading.Thread | None = None
@@ -121,6 +122,8 @@ class World:
     def label(self, text: str) -> None:
         self._label = text
         self.labels.append((float(self.data.time), text))
+        for hook in list(self.label_hooks):
+            hook(text)
 
     # ------------------------------------------------------------------ episodes
     def reset(self, seed: int | None = None) -> dict:
@@ -276,56 +279,59 @@ class World:
     def running(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
+    def set_speed(self, speed: float | None) -> None:
+        """Switch pacing at run time: ``speed`` x real time, or None for on demand (fast)."""
+        with self._cond:
+            self.speed = speed
+            self._anchor = None
+            self._cond.notify_all()
+
+    @property
+    def fast(self) -> bool:
+        return self.speed is None
+
     def _run(self) -> None:
-        if self.fast:
-            self._run_on_demand()
-        else:
-            self._run_paced()
-
-    def _run_on_demand(self) -> None:
         dt = self.model.opt.timestep
         while True:
+            pause = 0.0
             with self._cond:
                 if self._stop:
                     return
-                if not self._waiting or self.data.time >= max(self._waiting) - 0.5 * dt:
-                    self._cond.wait()  # nobody needs more simulated time
-                    continue
-                target = max(self._waiting)
-                first = min(self._waiting)
-                n = 0
-                while self.data.time < target - 0.5 * dt and n < 50:
-                    self._step_locked()
-                    n += 1
-                    if self.data.time >= first - 0.5 * dt:
-                        break
-                self._cond.notify_all()
-            # the lock is free here: waiters, servers and the scene get their turn
-
-    def _run_paced(self) -> None:
-        dt = self.model.opt.timestep
-        wall0 = time.perf_counter()
-        with self.lock:
-            sim0 = self.data.time
-        while True:
-            with self._cond:
-                if self._stop:
-                    return
-                target = sim0 + (time.perf_counter() - wall0) * self.speed
-                if target - self.data.time > 0.25 * self.speed:  # fell behind: do not catch up
-                    sim0, wall0 = self.data.time, time.perf_counter()
-                    target = sim0
-                n = 0
-                while self.data.time < target and n < 100:
-                    self._step_locked()
-                    n += 1
-                if n:
+                if self.speed is None:
+                    # on demand: step only up to what the waiters in sleep() need
+                    if not self._waiting or self.data.time >= max(self._waiting) - 0.5 * dt:
+                        self._cond.wait()  # nobody needs more simulated time
+                        continue
+                    target = max(self._waiting)
+                    first = min(self._waiting)
+                    n = 0
+                    while self.data.time < target - 0.5 * dt and n < 50:
+                        self._step_locked()
+                        n += 1
+                        if self.data.time >= first - 0.5 * dt:
+                            break
                     self._cond.notify_all()
-                ahead = (self.data.time - target) / self.speed
-                # reset() rewinds simulated time: re-anchor the clock
-                if self.data.time < sim0:
-                    sim0, wall0 = self.data.time, time.perf_counter()
-            time.sleep(max(ahead, 0.0) + min(0.004, 2 * dt / self.speed))
+                else:
+                    speed = self.speed
+                    now = time.perf_counter()
+                    # (re-)anchor on start, on a speed change, when reset() rewound time,
+                    # and when we fell behind (never try to catch up a backlog)
+                    if (self._anchor is None or self.data.time < self._anchor[0]
+                            or self._anchor[0] + (now - self._anchor[1]) * speed - self.data.time
+                            > 0.25 * speed):
+                        self._anchor = (self.data.time, now)
+                    sim0, wall0 = self._anchor
+                    target = sim0 + (now - wall0) * speed
+                    n = 0
+                    while self.data.time < target and n < 100:
+                        self._step_locked()
+                        n += 1
+                    if n:
+                        self._cond.notify_all()
+                    pause = max((self.data.time - target) / speed, 0.0) + min(0.004, 2 * dt / speed)
+            # the lock is free here: waiters, servers and the scene get their turn
+            if pause:
+                time.sleep(pause)
 
     def sleep(self, duration: float) -> None:
         """Wait until ``duration`` seconds of simulated time have passed.

@@ -32,5 +32,7 @@ def cli(*args, cwd=None, env=None, timeout=60):
     """``fsmscope ARGS`` in a real process; returns the CompletedProcess (text)."""
     full_env = dict(os.environ, **(env or {}))
     full_env["PYTHONPATH"] = ROOT + os.pathsep + full_env.get("PYTHONPATH", "")
+    if args and args[0] == "run" and "--exit" not in args:  # `run` keeps serving the dashboard unless --exit
+        args = ("run", "--exit") + tuple(args[1:])
     return subprocess.run([sys.executable, "-m", "server.cli", *map(str, args)], cwd=cwd or ROOT, env=full_env,
                           capture_output=True, text=True, timeout=timeout)

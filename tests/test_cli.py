@@ -114,7 +114,7 @@ def test_replay_reports_a_truncated_last_line_and_replays_the_rest(foo_bar_log, 
 def test_replay_follow_tails_a_log_until_its_writer_closes_it(tmp_path):
     log = tmp_path / "live.jsonl"
     env = dict(os.environ, FSMSCOPE_TIME_SCALE="0.05", PYTHONPATH=ROOT)
-    writer = subprocess.Popen([sys.executable, "-m", "server.cli", "run", os.path.join(EXAMPLES, "nested_monitor.py"),
+    writer = subprocess.Popen([sys.executable, "-m", "server.cli", "run", "--exit", os.path.join(EXAMPLES, "nested_monitor.py"),
                                "--record", str(log)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         done = cli("replay", "--follow", log, timeout=30)

@@ -104,10 +104,25 @@ class Reader:
 
     def events(self, handle: Any) -> Iterator[dict]:
         parse = self.parse
-        for raw in handle:
-            event = parse(raw, raw.endswith(b"\n"))
-            if event is not None:
-                yield event
+        version = SCHEMA_VERSION
+        lineno = self.lineno
+        try:
+            for raw in handle:
+                lineno += 1
+                try:  # the fast path: a complete, well-formed event
+                    event = loads(raw)
+                    if (type(event) is dict and event.get("v") == version and "kind" in event and "machine" in event
+                            and "path" in event and "seq" in event and raw[-1:] == b"\n"):
+                        yield event
+                        continue
+                except ValueError:
+                    pass
+                self.lineno = lineno - 1
+                event = parse(raw, raw.endswith(b"\n"))  # says what is wrong, or accepts it
+                if event is not None:
+                    yield event
+        finally:
+            self.lineno = lineno
 
 
 def read_events(path: str | os.PathLike, on_problem: Callable[[Problem], None] | None = None,

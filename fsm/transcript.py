@@ -100,10 +100,17 @@ class Transcript:
         return "%s %s" % (format_time(line.t), text) if with_time else text
 
 
+_second: list = [None, ""]  # the last whole second formatted, and its text
+
+
 def format_time(t: float | None) -> str:
+    """Local wall-clock time with milliseconds: ``12:34:56.789``."""
     if t is None:
         return "--:--:--.---"
-    return time.strftime("%H:%M:%S", time.localtime(t)) + ".%03d" % int((t % 1) * 1000)
+    whole = int(t // 1)
+    if _second[0] != whole:
+        _second[:] = [whole, time.strftime("%H:%M:%S", time.localtime(whole))]
+    return "%s.%03d" % (_second[1], int((t - whole) * 1000))
 
 
 def messages(events: Iterable[dict]) -> Iterator[Line]:

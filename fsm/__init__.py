@@ -20,3 +20,6 @@ __all__ = [
     "State", "CBState", "Container", "StateMachine", "Concurrence", "Sequence", "Iterator",
     "attach", "add_global_hook", "remove_global_hook", "Reporter",
 ]
+
+from .recorder import Recorder  # noqa: E402  (recording: fsm.attach(sm, fsm.Recorder("run.jsonl")))
+__all__.append("Recorder")

@@ -23,6 +23,7 @@ const app = {
   lastEdge: new Map(), // container path -> e: id of its last transition
   expand: null, // null: the server's default; else a Set of container paths drawn open
   preemptAsked: false,
+  preemptAck: null,
   finishedText: null, // "NAME finished: outcome 'X'" once the root terminated, until it starts again
   renderQueued: false,
   online: true,
@@ -105,7 +106,8 @@ function fillPicker() {
   const picker = $("machine-picker");
   const have = [...picker.options].map((o) => o.value + "\u0000" + o.textContent).join("\u0001");
   const labels = app.machines.map((m) => {
-    const state = m.running ? "running" : m.outcome ? "→ " + m.outcome : "idle";
+    const live = m.name === app.name && app.status?.structure ? app.status : m; // the stream is fresher
+    const state = live.running ? "running" : live.outcome ? "→ " + live.outcome : "idle";
     return [m.name, `${m.name}  (${state}${m.source === "ingest" ? ", remote" : ""})`];
   });
   if (labels.map(([v, t]) => v + "\u0000" + t).join("\u0001") === have) return;
@@ -214,8 +216,10 @@ function track(ev) {
       if (path === app.status.root_path) {
         const outcome = ev.outcome === null ? "no outcome" + (ev.error ? ` (${ev.error})` : "") : `outcome '${ev.outcome}'`;
         app.finishedText = `${app.name} finished: ${outcome}`;
-        notice(app.finishedText, ev.outcome === null ? "error" : app.preemptAsked ? "warn" : "ok", true);
+        const text = app.preemptAsked && app.preemptAck ? `${app.preemptAck}: ${app.finishedText}` : app.finishedText;
+        notice(text, ev.outcome === null ? "error" : app.preemptAsked ? "warn" : "ok", true);
         app.preemptAsked = false;
+        app.preemptAck = null;
       }
       break;
     }
@@ -365,13 +369,14 @@ $("preempt-btn").addEventListener("click", async () => {
   const answer = await confirmPreempt(name);
   if (!answer) return;
   app.preemptAsked = true;
+  app.preemptAck = null;
   app.finishedText = null;
   try {
     const ack = await api.preempt(name, answer.reason);
     if (name !== app.name) return;
     // The outcome may have arrived on the stream before this answer did.
-    notice(`Preempt accepted (event ${ack.seq}): ` + (app.finishedText || "waiting for the outcome…"),
-      "warn", true);
+    app.preemptAck = `Preempt accepted (event ${ack.seq})`;
+    notice(app.preemptAck + ": " + (app.finishedText || "waiting for the outcome…"), "warn", true);
   } catch (err) {
     app.preemptAsked = false;
     notice("Preempt failed: " + (err.detail || err.message), "error", true);
@@ -455,6 +460,7 @@ function render() {
   if (s.error && s.error.path) failed.push(s.error.state ? s.error.path + "/" + s.error.state : s.error.path);
   graph.apply({ active, running, reached, lastEdges: [...app.lastEdge.values()], failed, selected: app.selected });
   tree.update(s);
+  fillPicker();
   const udPath = userdata.path;
   userdata.update(s, udPath ? app.nodes.get(udPath) : null, udPath ? app.changed.get(udPath) : null);
   updateControls();

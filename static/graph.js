@@ -4,6 +4,7 @@
 // only the status changes. Pan (drag) and zoom (wheel) act on the SVG's viewBox.
 
 const SVG_NS = "http://www.w3.org/2000/svg";
+const MAX_FIT_SCALE = 1.7; // px per SVG unit (pt): about 1.3 times Graphviz's natural size
 const DROP_ELEMENTS = new Set(["script", "foreignobject", "iframe", "object", "embed", "image", "use", "animate",
   "set", "animatemotion", "animatetransform", "handler", "listener", "style"]);
 
@@ -191,10 +192,19 @@ export class GraphView {
     this._setViewBox({ ...this.vb, x: this.vb.x + dx, y: this.vb.y + dy });
   }
 
+  /** Show the whole graph, but never larger than MAX_FIT_SCALE pixels per SVG unit (a tiny graph stays small). */
   fit() {
     if (!this.base) return;
     const pad = Math.max(this.base.w, this.base.h) * 0.02;
-    this._setViewBox({ x: this.base.x - pad, y: this.base.y - pad, w: this.base.w + 2 * pad, h: this.base.h + 2 * pad });
+    let vb = { x: this.base.x - pad, y: this.base.y - pad, w: this.base.w + 2 * pad, h: this.base.h + 2 * pad };
+    const rect = this.host.getBoundingClientRect();
+    const scale = Math.min(rect.width / vb.w, rect.height / vb.h);
+    if (rect.width && rect.height && scale > MAX_FIT_SCALE) {
+      const w = rect.width / MAX_FIT_SCALE;
+      const h = rect.height / MAX_FIT_SCALE;
+      vb = { x: vb.x + vb.w / 2 - w / 2, y: vb.y + Math.min(vb.h / 2 - h / 2, 0), w, h };
+    }
+    this._setViewBox(vb);
   }
 
   zoom(factor, clientX, clientY) {

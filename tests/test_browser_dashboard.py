@@ -256,6 +256,31 @@ def test_names_and_values_render_as_text(page, server):
     assert page.dialogs == []
 
 
+def test_svg_is_sanitized_before_it_is_inlined(page):
+    evil = ('<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink">'
+            '<script>alert(1)</script><g id="s:/R/X" class="node" onclick="alert(2)">'
+            '<a xlink:href="javascript:alert(3)"><text>X</text></a><set attributeName="onmouseover" to="alert(4)"/></g>'
+            '<foreignObject><div xmlns="http://www.w3.org/1999/xhtml"><img src="x" onerror="alert(5)"/></div>'
+            '</foreignObject><image href="http://example.invalid/x.png"/></svg>')
+    markup = page.evaluate("""async (text) => {
+        const { parseSvg } = await import('/graph.js');
+        return parseSvg(text).outerHTML;
+    }""", evil)
+    for bad in ("script", "onclick", "javascript", "foreignObject", "onerror", "<set", "<image", "example.invalid"):
+        assert bad not in markup, (bad, markup)
+    assert 'id="s:/R/X"' in markup and ">X</text>" in markup
+
+
+def test_without_token_the_page_says_so(browser, server):
+    context = browser.new_context()
+    try:
+        page = context.new_page()
+        page.goto(server.base + "/")
+        page.wait_for_selector("#banner:has-text('Not authorized')")
+    finally:
+        context.close()
+
+
 def test_set_initial_state_validates_json(page, server):
     page.click('.tree-row[data-path="/SM_ROOT/NESTED/B"] .label', button="right")
     page.click("#menu button:has-text('Set as initial state')")
@@ -280,7 +305,8 @@ def test_preempt_then_start(page, server):
     page.click("#preempt-confirm")
     page.wait_for_selector("#notice:has-text('finished'), #notice:has-text('Preempt accepted')")
     page.wait_for_selector("#run-state:has-text('finished: preempted')")
-    assert "outcome 'preempted'" in page.text_content("#notice")
+    text = page.text_content("#notice")
+    assert "Preempt accepted (event " in text and "outcome 'preempted'" in text, text
     page.wait_for_selector('[id="o:/SM_ROOT:preempted"].reached')
     assert page.is_disabled("#preempt-btn")
     page.wait_for_selector("#start-btn:not([disabled])")

@@ -48,3 +48,18 @@ def logs() -> Logs:
     captured = Logs()
     captured.install()
     return captured
+
+
+@pytest.fixture
+def live_server():
+    """A real uvicorn serving a fresh Hub on a free port of 127.0.0.1, in a background thread.
+
+    Yields the ServerThread: ``.hub``, ``.base_url`` (http://127.0.0.1:PORT), ``.port``, ``.token``.
+    """
+    from server.introspection_server import ServerThread
+
+    srv = ServerThread().start()
+    try:
+        yield srv
+    finally:
+        srv.stop()

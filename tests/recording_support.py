@@ -36,3 +36,15 @@ def cli(*args, cwd=None, env=None, timeout=60):
         args = ("run", "--exit") + tuple(args[1:])
     return subprocess.run([sys.executable, "-m", "server.cli", *map(str, args)], cwd=cwd or ROOT, env=full_env,
                           capture_output=True, text=True, timeout=timeout)
+
+
+def two_state_loop(n):
+    """A machine that goes A -> B -> A ... until A has run ``n`` times, then ends 'done'."""
+    from smach_support import Out, machine
+    count = {"n": 0}
+
+    def a(ud):
+        count["n"] += 1
+        return "stop" if count["n"] >= n else "go"
+    return machine(["done"], [("A", Out(a, outcomes=["go", "stop"]), {"go": "B", "stop": "done"}),
+                              ("B", Out("go", outcomes=["go"]), {"go": "A"})])

@@ -10,18 +10,10 @@ from fsm.log_reader import LogError, SchemaError, follow, read_events, seek
 from fsm.recorder import Recorder, index_path
 from fsm.status import rebuild
 
-from recording_support import record
-from smach_support import Out, machine
+from recording_support import two_state_loop, record
 
 
-def _loop(n):
-    count = {"n": 0}
-
-    def a(ud):
-        count["n"] += 1
-        return "stop" if count["n"] >= n else "go"
-    return machine(["done"], [("A", Out(a, outcomes=["go", "stop"]), {"go": "B", "stop": "done"}),
-                              ("B", Out("go", outcomes=["go"]), {"go": "A"})])
+_loop = two_state_loop
 
 
 @pytest.fixture

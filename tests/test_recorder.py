@@ -15,8 +15,8 @@ from fsm.log_reader import read_events, read_index, writer_active
 from fsm.recorder import Recorder
 from fsm.status import Status, rebuild
 
-from recording_support import ROOT, load_example, record
-from smach_support import Out, machine
+from recording_support import two_state_loop, ROOT, load_example, record
+
 
 
 def _lines(path):
@@ -24,15 +24,7 @@ def _lines(path):
         return [loads(line) for line in handle]
 
 
-def _loop(n):
-    """A two-state loop that runs ``n`` times through A and B, then ends 'done'."""
-    count = {"n": 0}
-
-    def a(ud):
-        count["n"] += 1
-        return "stop" if count["n"] >= n else "go"
-    return machine(["done"], [("A", Out(a, outcomes=["go", "stop"]), {"go": "B", "stop": "done"}),
-                              ("B", Out("go", outcomes=["go"]), {"go": "A"})])
+_loop = two_state_loop
 
 
 def test_every_event_is_one_json_line_in_order(tmp_path):

@@ -1,0 +1,172 @@
+"""The websocket stream and ingest against a real uvicorn, with the `websockets` client."""
+
+import socket
+import threading
+import time
+
+import fsm
+import pytest
+from websockets.exceptions import InvalidStatus
+from websockets.sync.client import connect
+
+from server import hub as hub_module
+from server.publisher import Publisher
+from server_support import (client, events_of, frames, nested_machine, stream, two_state_machine, wait_for,
+                            waiting_machine)
+
+
+def has_terminate(got):
+    return any(e["kind"] == "terminate" and e["path"] == "/SM_ROOT" for e in events_of(got))
+
+
+def test_snapshot_first_then_every_event_in_order(live_server):
+    sm = nested_machine()
+    live_server.hub.add_local(sm, name="n")
+    with stream(live_server, "n") as ws:
+        [snap] = frames(ws, lambda got: len(got) == 1)
+        assert snap["type"] == "snapshot" and snap["last_seq"] == 0
+        assert snap["status"]["structure"]["path"] == "/SM_ROOT"
+        sm.execute()
+        events = events_of(frames(ws, has_terminate))
+    seqs = [e["seq"] for e in events]
+    assert seqs == list(range(1, len(seqs) + 1))
+    assert events[0]["kind"] == "structure"
+
+
+def test_since_resumes_with_the_missed_events_and_no_snapshot(live_server):
+    sm = two_state_machine()
+    live_server.hub.add_local(sm, name="two")
+    sm.execute()
+    with stream(live_server, "two", since=2) as ws:
+        got = frames(ws, has_terminate)
+    assert got[0]["type"] == "events"
+    assert [e["seq"] for e in events_of(got)][0] == 3
+
+
+def test_since_beyond_what_is_kept_gets_a_snapshot(live_server, monkeypatch):
+    sm = two_state_machine()
+    entry = live_server.hub.add_local(sm, name="two")
+    sm.execute()
+    wait_for(lambda: len(entry.ring) > 3)
+    for _ in range(3):
+        entry.ring.popleft()  # as if the ring had wrapped
+    with stream(live_server, "two", since=1) as ws:
+        [snap] = frames(ws, lambda got: len(got) == 1)
+    assert snap["type"] == "snapshot" and snap["status"]["outcome"] == "done"
+
+
+def test_stream_without_token_is_refused_401(live_server):
+    live_server.hub.add_local(two_state_machine(), name="two")
+    with pytest.raises(InvalidStatus) as info:
+        stream(live_server, "two", token=False)
+    assert info.value.response.status_code == 401
+
+
+def test_stream_from_a_foreign_origin_is_refused_403(live_server):
+    live_server.hub.add_local(two_state_machine(), name="two")
+    with pytest.raises(InvalidStatus) as info:
+        stream(live_server, "two", origin="http://evil.example")
+    assert info.value.response.status_code == 403
+
+
+def test_stream_of_an_unknown_machine_is_refused_404(live_server):
+    with pytest.raises(InvalidStatus) as info:
+        stream(live_server, "nope")
+    assert info.value.response.status_code == 404
+
+
+def test_a_client_that_falls_behind_gets_missed_then_a_snapshot(live_server, monkeypatch):
+    monkeypatch.setattr(hub_module, "CLIENT_QUEUE", 5)
+    sm = two_state_machine()
+    entry = live_server.hub.add_local(sm, name="two")
+    with stream(live_server, "two") as ws:
+        frames(ws, lambda got: len(got) == 1)
+        [client] = list(entry.clients)
+        client.wake.set = lambda: None  # the sender sleeps through the run: its queue overflows
+        sm.execute()
+        wait_for(lambda: client.need_snapshot and not live_server.hub._incoming)
+        asyncio_set(live_server, client)
+        got = frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
+    assert got[0]["type"] == "missed" and got[0]["count"] > 5
+    assert got[1]["status"]["outcome"] == "done"
+
+
+def asyncio_set(srv, client):
+    del client.wake.set
+    srv.hub.loop.call_soon_threadsafe(client.wake.set)
+
+
+def test_a_stalled_client_is_dropped_and_the_machine_does_not_wait(live_server, monkeypatch):
+    monkeypatch.setattr(hub_module, "SEND_TIMEOUT", 0.5)
+    monkeypatch.setattr(hub_module, "CLIENT_QUEUE", 100000)
+    counter = {"n": 0}
+
+    def loop(ud):
+        counter["n"] += 1
+        ud.blob = "x" * 2000
+        return "again" if counter["n"] < 20000 else "stop"
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(loop, outcomes=["again", "stop"], output_keys=["blob"]),
+                             {"again": "A", "stop": "done"})
+    entry = live_server.hub.add_local(sm, name="loop")
+    raw = socket.create_connection(("127.0.0.1", live_server.port))
+    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    raw.sendall(("GET /api/machines/loop/stream?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
+                 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                 "Sec-WebSocket-Version: 13\r\n\r\n" % (live_server.token, live_server.port)).encode())
+    assert b"101" in raw.recv(200)  # then never read again
+    wait_for(lambda: len(entry.clients) == 1)
+    started = time.monotonic()
+    assert sm.execute() == "done"
+    assert time.monotonic() - started < 5
+    wait_for(lambda: not entry.clients, timeout=5)
+    raw.close()
+
+
+def test_publisher_in_another_thread_shows_its_machine_as_ingest(live_server):
+    pub = Publisher(live_server.base_url, live_server.token)
+    sm = two_state_machine()
+    fsm.attach(sm, pub, name="remote")
+    assert pub.connected.wait(5)
+    sm.execute()
+    assert pub.flush(5)
+    http = client(live_server)
+    wait_for(lambda: http.get("/api/machines/remote/status").status_code == 200 and
+             http.get("/api/machines/remote/status").json()["outcome"] == "done")
+    [info] = [m for m in http.get("/api/machines").json() if m["name"] == "remote"]
+    assert info["source"] == "ingest" and info["can_start"] is False
+    assert http.post("/api/machines/remote/preempt", json={}).status_code == 409
+    pub.close()
+
+
+def test_ingest_without_token_is_refused_401(live_server):
+    with pytest.raises(InvalidStatus) as info:
+        connect("ws://127.0.0.1:%d/api/ingest" % live_server.port, open_timeout=5)
+    assert info.value.response.status_code == 401
+
+
+def test_publisher_keeps_the_machine_running_without_a_server_and_reconnects():
+    from server.introspection_server import ServerThread
+
+    srv = ServerThread().start()
+    port, token = srv.port, srv.token
+    pub = Publisher(srv.base_url, token, backoff_max=0.2)
+    sm, wait = waiting_machine()
+    fsm.attach(sm, pub, name="away")
+    assert pub.connected.wait(5)
+    srv.stop()
+    thread = threading.Thread(target=sm.execute, daemon=True)
+    thread.start()
+    assert wait.entered.wait(5)  # the machine runs while the server is gone
+    srv2 = ServerThread(port=port, token=token).start()
+    try:
+        wait_for(lambda: srv2.hub.get("away") is not None and srv2.hub.get("away").status.running, timeout=10)
+        wait.release.set()
+        thread.join(5)
+        wait_for(lambda: srv2.hub.get("away").status.outcome == "done", timeout=5)
+    finally:
+        wait.release.set()
+        pub.close(1)
+        srv2.stop()

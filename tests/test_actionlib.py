@@ -1,12 +1,11 @@
 """fsm.actionlib: a SimpleActionServer and SimpleActionClient talking over a bus, with real threads."""
 
 import threading
-import time
 
 import pytest
 
 from fsm.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
-from bus_support import bus, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
 
 
 def test_goal_status_names():
@@ -88,8 +87,7 @@ def test_pending_goal_replaced_by_a_newer_one_is_preempted_without_running(bus, 
     server = serve(bus, servers, execute)
     clients = [SimpleActionClient("act", bus=bus) for _ in range(3)]
     clients[0].send_goal("a")
-    while not server.is_active():
-        time.sleep(0.001)
+    assert eventually(server.is_active)
     clients[1].send_goal("b")
     clients[2].send_goal("c")
     assert clients[1].wait_for_result(timeout=1.0)

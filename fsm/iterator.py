@@ -5,6 +5,7 @@ from typing import Any, Callable, Iterable
 
 from . import introspection, log
 from .container import Container
+from .encoding import encode
 from .exceptions import InvalidUserCodeError
 from .state import State
 
@@ -74,20 +75,27 @@ class Iterator(Container):
         outcome = self._exhausted_outcome
         state_outcome = None
         rep = self._reporter
+        looped = None  # while observed: the outcome of a looping iteration, reported once the next item is known
         while not log.is_shutdown():
             try:
                 item = next(it)
             except Exception:  # any failure of the iterable counts as exhaustion, as in SMACH
                 break
+            if looped is not None:
+                rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(looped),
+                                                    "to": str(self._state_label), "active": [str(self._state_label)],
+                                                    "item": encode(item)})
+                looped = None
             log.loginfo("Iterating %s of %s" % (str(item), str(items)))
             self.userdata[self._items_label] = item
             try:
                 state_outcome = self._state.execute(self.userdata)
             except InvalidUserCodeError:
                 raise
-            except Exception:
-                raise InvalidUserCodeError("Could not execute iterator state '%s' of type '%s': "
-                                           % (self._state_label, self._state) + traceback.format_exc())
+            except Exception as exc:
+                raise introspection.carry_reported(InvalidUserCodeError(
+                    "Could not execute iterator state '%s' of type '%s': " % (self._state_label, self._state)
+                    + traceback.format_exc()), exc)
             if rep is not None:
                 self._report_changes()
             if self._preempt_requested:
@@ -98,13 +106,13 @@ class Iterator(Container):
                 outcome = self._final_outcome_map.get(state_outcome, state_outcome)
                 break
             if rep is not None:
-                rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(state_outcome),
-                                                    "to": str(self._state_label), "active": [str(self._state_label)]})
+                looped = state_outcome
             self.call_transition_cbs()
         self._copy_output_keys(self.userdata, parent_ud)
         self._is_running = False
-        self._report("terminate", {"last": [str(self._state_label)], "outcome": None if outcome is None else str(outcome),
-                                   "active": []})
+        self._report("terminate", {"last": [str(self._state_label)],
+                                   "state_outcome": None if state_outcome is None else str(state_outcome),
+                                   "outcome": None if outcome is None else str(outcome), "active": []})
         self.call_termination_cbs(self._state_label, outcome)
         return outcome
 

@@ -127,9 +127,9 @@ class StateMachine(Container):
         except InvalidUserCodeError as ex:
             log.logerr("State '%s' failed to execute." % last_state_label)
             raise ex
-        except Exception:
-            raise InvalidUserCodeError("Could not execute state '%s' of type '%s': " % (last_state_label, state)
-                                       + traceback.format_exc())
+        except Exception as exc:
+            raise introspection.carry_reported(InvalidUserCodeError(
+                "Could not execute state '%s' of type '%s': " % (last_state_label, state) + traceback.format_exc()), exc)
         finally:
             lock.acquire()
 
@@ -165,7 +165,8 @@ class StateMachine(Container):
             self._set_current_state(None)
             log.info_quiet("State machine terminating '%s':'%s':'%s'" % (last_state_label, outcome, target))
             if rep is not None:
-                rep.emit("terminate", self._path, {"last": [str(last_state_label)], "outcome": str(target), "active": []})
+                rep.emit("terminate", self._path, {"last": [str(last_state_label)], "state_outcome": str(outcome),
+                                                   "outcome": str(target), "active": []})
             self.call_termination_cbs([last_state_label], target)
             return target
         raise InvalidTransitionError("Outcome '%s' of state '%s' with transition target '%s' is neither a registered state nor a registered container outcome."

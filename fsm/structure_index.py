@@ -1,9 +1,7 @@
 """What a machine's ``structure`` events say about each container path, for readers of a log.
 
-Replay needs two facts the other events leave implicit: which kind of container a path
-is (a StateMachine prints different lines from a Concurrence), and which outcome of the
-last state led to a container's termination (a ``terminate`` event carries the container
-outcome; the state's own outcome follows from the container's transitions).
+Replay needs one fact the other events leave implicit: which kind of container a path
+is (a StateMachine prints different lines from a Concurrence).
 """
 
 from __future__ import annotations
@@ -60,26 +58,3 @@ class StructureIndex:
         if event.get("kind") == "transition" and event.get("from") == event.get("to"):
             return "Iterator"
         return "StateMachine"
-
-    def state_outcome(self, event: dict) -> str | None:
-        """The last state's outcome that ended a StateMachine (``terminate`` event), best effort.
-
-        Uses the event's own ``state_outcome`` when it has one; otherwise the transition of the
-        last state that leads to the container outcome (preferring the outcome of the same
-        name when several do).
-        """
-        if "state_outcome" in event:
-            return event["state_outcome"]
-        outcome = event.get("outcome")
-        last = (event.get("last") or [None])[0]
-        if outcome is None or last is None:
-            return outcome
-        node = self._nodes.get((event["machine"], event["path"]))
-        if node is None:
-            return outcome
-        candidates = [t["outcome"] for t in node.get("transitions", ())
-                      if t.get("from") == last and (t.get("to") == outcome
-                                                    or (t.get("to") in (None, "") and t.get("outcome") == outcome))]
-        if not candidates or outcome in candidates:
-            return outcome
-        return candidates[0]

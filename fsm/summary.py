@@ -114,7 +114,7 @@ class Summary:
             outcome = event.get("outcome")
             last = event.get("last") or []
             if outcome is not None and self.structures.container_type(event) != "Concurrence" and last:
-                key = (path, str(last[0]), str(self.structures.state_outcome(event)), str(outcome))
+                key = (path, str(last[0]), str(event.get("state_outcome", outcome)), str(outcome))
                 m.transitions[key] = m.transitions.get(key, 0) + 1
             if path == m.root_path:
                 m.outcome = outcome

@@ -92,7 +92,7 @@ class Transcript:
             return []
         last = (event.get("last") or ["None"])[0]
         return [("info", "State machine terminating '%s':'%s':'%s'"
-                 % (last, self.structures.state_outcome(event), outcome))]
+                 % (last, event.get("state_outcome", outcome), outcome))]
 
     def format(self, line: Line, with_time: bool = True) -> str:
         where = line.path if len(self.machines) < 2 else "%s:%s" % (line.machine, line.path)

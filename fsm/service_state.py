@@ -6,7 +6,7 @@ from typing import Any, Callable, Iterable
 from . import log
 from .bus import Bus, ServiceException, get_bus
 from .preemptible import PreemptibleState
-from .slots import get_slot, set_slot
+from .slots import set_slot, store
 from .user_callback import FAILED, UserCallback
 
 
@@ -75,12 +75,9 @@ class ServiceState(PreemptibleState):
                            % (key, list(ud.keys())))
                 return "aborted"
             set_slot(request, key, ud[key])
-        if self._request_cb:
-            update = self._request_cb.run(ud, request)
-            if update is FAILED:
-                return "aborted"
-            if update is not None:
-                request = update
+        request = self._request_cb.update(ud, request)
+        if request is FAILED:
+            return "aborted"
         if request is None:
             log.logerr("Attempting to call service " + name + " with no request")
             return "aborted"
@@ -92,15 +89,10 @@ class ServiceState(PreemptibleState):
             log.logerr("Exception when calling service '%s': %s" % (name, ex))
             return "aborted"
 
-        outcome = None
-        if self._response_cb:
-            outcome = self._response_cb.run(ud, response)
-            if outcome is FAILED:
-                return "aborted"
-        if self._response_key is not None:
-            ud[self._response_key] = response
-        for key in self._response_slots:
-            ud[key] = get_slot(response, key)
+        outcome = self._response_cb.run(ud, response)
+        if outcome is FAILED:
+            return "aborted"
+        store(ud, response, self._response_key, self._response_slots)
         return outcome if outcome is not None else "succeeded"
 
     def _initial_request(self) -> Any:

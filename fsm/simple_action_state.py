@@ -10,7 +10,7 @@ from .bus import Bus, get_bus
 from .encoding import encode
 from .exceptions import InvalidStateError
 from .preemptible import PreemptibleState, to_seconds
-from .slots import get_slot, set_slot
+from .slots import set_slot, store
 from .user_callback import FAILED, UserCallback
 
 
@@ -98,12 +98,9 @@ class SimpleActionState(PreemptibleState):
             goal = ud[self._goal_key]
         for key in self._goal_slots:
             set_slot(goal, key, ud[key])
-        if self._goal_cb:
-            update = self._goal_cb.run(ud, goal)
-            if update is FAILED:
-                return "aborted"
-            if update is not None:
-                goal = update
+        goal = self._goal_cb.update(ud, goal)
+        if goal is FAILED:
+            return "aborted"
         if goal is None:
             log.logerr("Attempting to activate action " + name + " with no goal or goal callback set. "
                        "Did you construct the SimpleActionState properly?")
@@ -116,16 +113,10 @@ class SimpleActionState(PreemptibleState):
 
         status = self._client.get_state()
         result = self._client.get_result()
-        outcome = None
-        if self._result_cb:
-            outcome = self._result_cb.run(ud, status, result)
-            if outcome is FAILED:
-                return "aborted"
-        if self._result_key is not None:
-            ud[self._result_key] = result
-        if result is not None:
-            for key in self._result_slots:
-                ud[key] = get_slot(result, key)
+        outcome = self._result_cb.run(ud, status, result)
+        if outcome is FAILED:
+            return "aborted"
+        store(ud, result, self._result_key, self._result_slots)
         if status == GoalStatus.SUCCEEDED:
             default = "succeeded"
         elif status == GoalStatus.PREEMPTED and self.preempt_requested():
@@ -179,5 +170,4 @@ class SimpleActionState(PreemptibleState):
         rep = self._reporter
         if rep is not None:
             rep.emit("feedback", self._path, {"action": self._action_name, "feedback": encode(feedback)})
-        if self._feedback_cb:
-            self._feedback_cb.run(self._ud, feedback)
+        self._feedback_cb.run(self._ud, feedback)

@@ -48,11 +48,16 @@ class UserCallback:
             self._input_keys = tuple(input_keys)
             self._output_keys = tuple(output_keys)
 
-    def __bool__(self) -> bool:
-        return self._cb is not None
+    def update(self, ud: Any, msg: Any) -> Any:
+        """``msg`` as the callback rewrote it: its non-None return replaces it. FAILED if it raised."""
+        value = self.run(ud, msg)
+        return msg if value is None else value
 
     def run(self, ud: Any, *leading: Any) -> Any:
-        """The callback's return value, or FAILED (logged) if it raised or returned a foreign outcome."""
+        """The callback's return value (None without a callback), or FAILED (logged) if it raised
+        or returned a foreign outcome."""
+        if self._cb is None:
+            return None
         try:
             value = self._cb(Remapper(ud, self._input_keys, self._output_keys), *leading,
                              *self._args, **self._kwargs)

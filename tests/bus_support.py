@@ -2,8 +2,8 @@
 
 import time
 
+import fsm as smach
 import pytest
-
 from fsm.actionlib import SimpleActionServer
 from fsm.bus import Bus
 
@@ -50,3 +50,11 @@ def eventually(predicate, timeout: float = 1.0) -> bool:
             return False
         time.sleep(0.001)
     return True
+
+
+def ud_with(**values) -> smach.UserData:
+    """A top-level UserData holding ``values``, for running a state's execute directly."""
+    ud = smach.UserData()
+    for key, value in values.items():
+        ud[key] = value
+    return ud

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus, eventually  # noqa: F401 (fixture)
+from bus_support import bus, eventually, ud_with  # noqa: F401 (fixture)
 from fsm.bus import default_bus
 from fsm.service_state import ServiceState
 from smach_support import Background, machine
@@ -22,13 +22,6 @@ def add_service(bus, name="add"):
         return SimpleNamespace(sum=req["a"] + req["b"])
     bus.advertise_service(name, handler)
     return requests
-
-
-def ud_with(**values) -> smach.UserData:
-    ud = smach.UserData()
-    for key, value in values.items():
-        ud[key] = value
-    return ud
 
 
 def test_outcomes_always_include_succeeded_aborted_preempted(bus):

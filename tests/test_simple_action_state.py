@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from bus_support import bus, eventually, ud_with, serve, servers, until_preempted  # noqa: F401 (fixtures)
 from fsm.actionlib import GoalStatus
 from fsm.simple_action_state import SimpleActionState
 from smach_support import Background, machine
@@ -23,13 +23,6 @@ def doubler(bus, servers, name="act"):
     server = serve(bus, servers, execute, name, auto_start=False)
     server.start()
     return goals
-
-
-def ud_with(**values) -> smach.UserData:
-    ud = smach.UserData()
-    for key, value in values.items():
-        ud[key] = value
-    return ud
 
 
 def state(bus, **kwargs) -> SimpleActionState:

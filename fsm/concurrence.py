@@ -150,7 +150,8 @@ class Concurrence(Container):
         first = next(iter(failed.values()))
         if isinstance(first, (InvalidStateError, InvalidUserCodeError)) and getattr(first, "_fsm_own", False):
             raise first
-        raise InvalidStateError("A concurrent state raised an exception during execution.") from first
+        raise introspection.carry_reported(
+            InvalidStateError("A concurrent state raised an exception during execution."), first) from first
 
     def _run_child(self, label: str, state: State) -> None:
         rep = self._reporter

@@ -53,7 +53,8 @@ class Reporter:
         _set_listening(self, True)
 
     def remove_observer(self, observer: Observer) -> None:
-        self._observers = [o for o in self._observers if o is not observer]
+        # Equality, not identity: ``remove_observer(events.append)`` must match the bound method given to attach.
+        self._observers = [o for o in self._observers if o != observer]
         if not self._observers:
             _set_listening(self, False)
 
@@ -190,6 +191,13 @@ def take_changes(userdata: Any) -> dict | None:
     userdata._dirty = set()
     data = userdata._data
     return encode_userdata({k: data[k] for k in dirty if k in data})
+
+
+def carry_reported(error: BaseException, cause: BaseException) -> BaseException:
+    """``error`` wraps ``cause``: when an ``error`` event already described ``cause``, none is sent for ``error``."""
+    if getattr(cause, "_fsm_reported", False):
+        error._fsm_reported = True  # type: ignore[attr-defined]
+    return error
 
 
 def error_fields(state_label: Any, exc: BaseException, tb: str) -> dict:

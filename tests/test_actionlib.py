@@ -8,6 +8,16 @@ from fsm.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
 from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
 
 
+def running_goal(bus, servers):
+    """A server whose goal runs until preempted, and a client whose goal it is running."""
+    started = threading.Event()
+    server = serve(bus, servers, lambda goal: (started.set(), until_preempted(server)(goal)))
+    client = SimpleActionClient("act", bus=bus)
+    client.send_goal("g")
+    assert started.wait(1.0)
+    return server, client
+
+
 def test_goal_status_names():
     assert [GoalStatus.name(s) for s in range(5)] == ["PENDING", "ACTIVE", "PREEMPTED", "SUCCEEDED", "ABORTED"]
     assert GoalStatus.name(9) == "UNKNOWN (9)"
@@ -49,11 +59,7 @@ def test_callbacks_get_active_feedback_and_done(bus, servers):
 
 
 def test_cancel_goal_requests_preempt_of_the_active_goal(bus, servers):
-    started = threading.Event()
-    server = serve(bus, servers, lambda goal: (started.set(), until_preempted(server)(goal)))
-    client = SimpleActionClient("act", bus=bus)
-    client.send_goal("g")
-    assert started.wait(1.0)
+    server, client = running_goal(bus, servers)
     assert server.is_active() and not server.is_preempt_requested()
     client.cancel_goal()
     assert client.wait_for_result(timeout=1.0)
@@ -62,12 +68,8 @@ def test_cancel_goal_requests_preempt_of_the_active_goal(bus, servers):
 
 
 def test_new_goal_preempts_the_active_one(bus, servers):
-    started = threading.Event()
-    server = serve(bus, servers, lambda goal: (started.set(), until_preempted(server)(goal)))
-    first = SimpleActionClient("act", bus=bus)
+    server, first = running_goal(bus, servers)
     second = SimpleActionClient("act", bus=bus)
-    first.send_goal("one")
-    assert started.wait(1.0)
     second.send_goal("two")
     assert first.wait_for_result(timeout=1.0)
     assert first.get_state() == GoalStatus.PREEMPTED
@@ -139,9 +141,7 @@ def test_goal_sent_with_no_server_is_aborted_at_once(bus, logs):
 
 
 def test_wait_for_result_times_out_while_the_goal_runs(bus, servers):
-    server = serve(bus, servers, lambda goal: until_preempted(server)(goal))
-    client = SimpleActionClient("act", bus=bus)
-    client.send_goal("g")
+    server, client = running_goal(bus, servers)
     assert not client.wait_for_result(timeout=0.05)
     client.cancel_goal()
     assert client.wait_for_result(timeout=1.0)
@@ -165,11 +165,7 @@ def test_auto_start_false_registers_only_on_start(bus, servers):
 
 
 def test_shutdown_preempts_the_active_goal_and_unregisters(bus, servers):
-    started = threading.Event()
-    server = serve(bus, servers, lambda goal: (started.set(), until_preempted(server)(goal)))
-    client = SimpleActionClient("act", bus=bus)
-    client.send_goal("g")
-    assert started.wait(1.0)
+    server, client = running_goal(bus, servers)
     assert server.shutdown(timeout=1.0)
     assert client.get_state() == GoalStatus.PREEMPTED
     assert bus.action_server("act") is None

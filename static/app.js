@@ -460,6 +460,7 @@ function render() {
   if (s.error && s.error.path) failed.push(s.error.state ? s.error.path + "/" + s.error.state : s.error.path);
   graph.apply({ active, running, reached, lastEdges: [...app.lastEdge.values()], failed, selected: app.selected });
   tree.update(s);
+  log.flush();
   fillPicker();
   const udPath = userdata.path;
   userdata.update(s, udPath ? app.nodes.get(udPath) : null, udPath ? app.changed.get(udPath) : null);

@@ -191,6 +191,7 @@ export class UserdataPanel {
 
 const MAX_EVENTS = 5000;
 const MAX_ROWS = 800;
+const MAX_ROWS_PER_FRAME = 120; // under a flood only the newest rows of each frame are drawn
 
 function selectionOf(ev) {
   const path = ev.path;
@@ -214,6 +215,11 @@ export class EventLog {
     this.controls = controls; // {kind: select, path: input, count: element, clear: button}
     this.handlers = handlers;
     this.events = [];
+    this.pending = []; // events not drawn yet
+    this.stick = true; // follow the newest row (false once the user scrolls up)
+    host.addEventListener("scroll", () => {
+      this.stick = host.scrollHeight - host.scrollTop - host.clientHeight < 24;
+    }, { passive: true });
     this.nodeOf = () => undefined;
     this.selectedRow = null;
     controls.kind.addEventListener("change", () => this.redraw());
@@ -251,16 +257,21 @@ export class EventLog {
       h("span", { class: "msg", text: line.text, title: ev.kind === "error" && ev.traceback ? ev.traceback : line.text }));
   }
 
-  _atBottom() {
-    const el = this.host;
-    return el.scrollHeight - el.scrollTop - el.clientHeight < 24;
-  }
 
+  /** Keep events; their rows are drawn by the next flush() (once per animation frame, however fast they come). */
   add(events) {
     for (const ev of events) this.events.push(ev);
     if (this.events.length > MAX_EVENTS) this.events.splice(0, this.events.length - MAX_EVENTS);
-    const stick = this._atBottom();
-    const fresh = events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS).map((ev) => this._row(ev));
+    for (const ev of events) this.pending.push(ev);
+    if (this.pending.length > 4 * MAX_ROWS_PER_FRAME) this.pending.splice(0, this.pending.length - MAX_ROWS_PER_FRAME);
+  }
+
+  flush() {
+    if (!this.pending.length) return;
+    const events = this.pending;
+    this.pending = [];
+    const stick = this.stick;
+    const fresh = events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS_PER_FRAME).map((ev) => this._row(ev));
     if (fresh.length) {
       this.host.querySelector(".empty")?.remove();
       this.host.append(...fresh);
@@ -272,10 +283,12 @@ export class EventLog {
   }
 
   redraw() {
+    this.pending = [];
     const rows = this.events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS).map((ev) => this._row(ev));
     this.host.replaceChildren(...(rows.length ? rows : [h("p", { class: "empty", text: "No events." })]));
     this.selectedRow = null;
     this._count();
+    this.stick = true;
     this.host.scrollTop = this.host.scrollHeight;
   }
 

@@ -89,3 +89,12 @@ class Background:
         if self.error is not None:
             raise self.error
         return self.result
+
+
+def preempt_while_running(container: Any, *waiting: WaitForPreempt, timeout: float = 5.0) -> Any:
+    """Execute ``container`` in a thread and preempt it once every ``waiting`` state runs; returns its outcome."""
+    run = Background(container.execute)
+    for state in waiting:
+        assert state.started.wait(timeout), "a state that should block never started"
+    container.request_preempt()
+    return run.join(timeout)

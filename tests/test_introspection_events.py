@@ -4,7 +4,7 @@ import fsm as smach
 import fsm.log
 import pytest
 
-from smach_support import Background, Out, WaitForPreempt, concurrence, machine
+from smach_support import Out, WaitForPreempt, concurrence, machine, preempt_while_running
 
 COMMON = {"v", "seq", "t", "run", "machine", "kind", "path"}
 
@@ -185,10 +185,7 @@ def test_preempt_emits_requested_and_serviced_events(observe, logs):
     inner = machine(["preempted"], [("WAIT", wait, {})])
     sm = machine(["preempted"], [("SUB", inner, {})])
     events = observe(sm)
-    run = Background(sm.execute)
-    assert wait.started.wait(5)
-    sm.request_preempt()
-    assert run.join() == "preempted"
+    assert preempt_while_running(sm, wait) == "preempted"
     preempts = [(e["path"], e["phase"]) for e in events if e["kind"] == "preempt"]
     assert preempts[:2] == [("/SM_ROOT", "requested"), ("/SM_ROOT/SUB", "requested")]
     assert ("/SM_ROOT/SUB/WAIT", "serviced") in preempts

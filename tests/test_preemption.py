@@ -3,7 +3,7 @@
 import fsm as smach
 import pytest
 
-from smach_support import Background, Out, WaitForPreempt, concurrence, machine
+from smach_support import Out, WaitForPreempt, concurrence, machine, preempt_while_running
 
 pytestmark = pytest.mark.timeout(10)
 
@@ -23,10 +23,7 @@ def test_serviced_preempt_is_consumed_and_the_next_state_runs_normally(logs):
     first = WaitForPreempt(outcomes=["preempted"])
     second = Out("done")
     sm = machine(["done"], [("W1", first, {"preempted": "W2"}), ("W2", second, {})])
-    run = Background(sm.execute)
-    assert first.started.wait(5)
-    sm.request_preempt()
-    assert run.join() == "done"
+    assert preempt_while_running(sm, first) == "done"
     assert second.saw_preempt == [False]
     assert not sm.preempt_requested()
 
@@ -35,10 +32,7 @@ def test_unserviced_preempt_is_forwarded_to_the_next_state_and_stays_requested(l
     first = WaitForPreempt(outcomes=["done"], service=False, result="done")
     second = Out("done")
     sm = machine(["done"], [("W1", first, {"done": "W2"}), ("W2", second, {})])
-    run = Background(sm.execute)
-    assert first.started.wait(5)
-    sm.request_preempt()
-    assert run.join() == "done"
+    assert preempt_while_running(sm, first) == "done"
     assert second.saw_preempt == [True]
     assert ("Last state 'W1' did not service preempt. Preempting next state 'W2' before executing..."
             in logs.info)
@@ -48,20 +42,14 @@ def test_unserviced_preempt_is_forwarded_to_the_next_state_and_stays_requested(l
 def test_serviced_preempt_of_the_last_state_is_serviced_by_the_machine(logs):
     leaf = WaitForPreempt(outcomes=["preempted"])
     sm = machine(["preempted"], [("W", leaf, {})])
-    run = Background(sm.execute)
-    assert leaf.started.wait(5)
-    sm.request_preempt()
-    assert run.join() == "preempted"
+    assert preempt_while_running(sm, leaf) == "preempted"
     assert not sm.preempt_requested()
 
 
 def test_concurrence_returns_preempted_when_every_child_services_the_preempt(logs):
     a, b = WaitForPreempt(), WaitForPreempt()
     cc = concurrence(["done"], "done", [("A", a), ("B", b)])
-    run = Background(cc.execute)
-    assert a.started.wait(5) and b.started.wait(5)
-    cc.request_preempt()
-    assert run.join() == "preempted"
+    assert preempt_while_running(cc, a, b) == "preempted"
     assert "Concurrence serviced preempt." in logs.info
     assert not cc.preempt_requested()
 
@@ -70,11 +58,8 @@ def test_parent_machine_rejects_a_concurrence_preempted_outcome_it_does_not_regi
     a = WaitForPreempt()
     cc = concurrence(["done"], "done", [("A", a)])
     sm = machine(["done"], [("CC", cc, {})])
-    run = Background(sm.execute)
-    assert a.started.wait(5)
-    sm.request_preempt()
     with pytest.raises(smach.InvalidTransitionError) as info:
-        run.join()
+        preempt_while_running(sm, a)
     assert str(info.value) == ("Attempted to return outcome 'preempted' from state 'CC' of type '%s' which only "
                                "has registered outcomes: ('done',)" % cc)
 
@@ -83,10 +68,7 @@ def test_concurrence_recalls_unserviced_preempts_and_uses_its_outcome_policy(log
     a = WaitForPreempt()
     b = WaitForPreempt(outcomes=["done"], service=False, result="done")
     cc = concurrence(["mapped", "other"], "other", [("A", a), ("B", b)], outcome_map={"mapped": {"B": "done"}})
-    run = Background(cc.execute)
-    assert a.started.wait(5) and b.started.wait(5)
-    cc.request_preempt()
-    assert run.join() == "mapped"
+    assert preempt_while_running(cc, a, b) == "mapped"
     assert logs.warn == ["State 'B' in concurrence did not service preempt."]
     assert not b.preempt_requested()
     assert cc.preempt_requested()
@@ -137,10 +119,7 @@ def test_preempt_propagates_through_state_machine_concurrence_state_machine_to_l
     inner = machine(["preempted"], [("LEAF", leaf, {})])
     cc = concurrence(["done", "preempted"], "done", [("SUB", inner), ("SIBLING", sibling)])
     outer = machine(["done", "preempted"], [("CC", cc, {})])
-    run = Background(outer.execute)
-    assert leaf.started.wait(5) and sibling.started.wait(5)
-    outer.request_preempt()
-    assert run.join() == "preempted"
+    assert preempt_while_running(outer, leaf, sibling) == "preempted"
     assert [c.preempt_requested() for c in (outer, cc, inner, leaf, sibling)] == [False] * 5
 
 
@@ -150,10 +129,7 @@ def test_preempt_propagates_through_state_machine_to_iterator_contents(logs):
     with it:
         smach.Iterator.set_contained_state("BODY", body, loop_outcomes=["next"], final_outcome_map={"next": "preempted"})
     sm = machine(["preempted", "exhausted"], [("IT", it, {})])
-    run = Background(sm.execute)
-    assert body.started.wait(5)
-    sm.request_preempt()
-    assert run.join() == "preempted"
+    assert preempt_while_running(sm, body) == "preempted"
     assert logs.info.count("Iterating 1 of [1, 2, 3]") == 1
     assert not any(line.startswith("Iterating 2") for line in logs.info)
     assert not it.preempt_requested()

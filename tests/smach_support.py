@@ -98,3 +98,10 @@ def preempt_while_running(container: Any, *waiting: WaitForPreempt, timeout: flo
         assert state.started.wait(timeout), "a state that should block never started"
     container.request_preempt()
     return run.join(timeout)
+
+
+def userdata(**values: Any) -> smach.UserData:
+    """A UserData holding ``values``."""
+    ud = smach.UserData()
+    ud.update(values)
+    return ud

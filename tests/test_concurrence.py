@@ -5,7 +5,7 @@ import threading
 import fsm as smach
 import pytest
 
-from smach_support import Out, WaitForPreempt, concurrence, machine
+from smach_support import Out, WaitForPreempt, concurrence, machine, userdata
 
 pytestmark = pytest.mark.timeout(10)
 
@@ -168,8 +168,7 @@ def test_concurrence_initial_states_are_all_children_and_idle_active_states_are_
 
 def test_concurrence_set_initial_state_merges_userdata():
     cc = _two("done", "done")
-    ud = smach.UserData()
-    ud.x = 42
+    ud = userdata(x=42)
     cc.set_initial_state(["A", "B"], ud)
     assert cc.userdata.x == 42
     assert cc.get_initial_states() == ["A", "B"]
@@ -177,8 +176,7 @@ def test_concurrence_set_initial_state_merges_userdata():
 
 def test_concurrence_start_line_lists_the_copied_input_keys(logs):
     cc = concurrence(["d"], "d", [("A", Out("done"))], input_keys=["k"])
-    parent = smach.UserData()
-    parent.k = 1
+    parent = userdata(k=1)
     cc.execute(parent)
     assert logs.info[0] == "Concurrence starting with userdata: \n\t['k']"
 

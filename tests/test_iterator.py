@@ -3,7 +3,7 @@
 import fsm as smach
 import pytest
 
-from smach_support import Out, machine
+from smach_support import Out, machine, userdata
 
 
 def _iterator(items, body, outcomes=None, input_keys=(), output_keys=(), label="BODY", contained=None, **kwargs):
@@ -157,8 +157,7 @@ def test_shutdown_check_stops_the_iterator_with_the_exhausted_outcome():
 
 def test_iterator_set_initial_state_merges_userdata():
     it = _iterator([1], Out("next", outcomes=["next"]), contained={"loop_outcomes": ["next"]})
-    ud = smach.UserData()
-    ud.x = 42
+    ud = userdata(x=42)
     it.set_initial_state(["BODY"], ud)
     assert it.userdata.x == 42
     assert it.get_initial_states() == ["BODY"]
@@ -166,8 +165,7 @@ def test_iterator_set_initial_state_merges_userdata():
 
 def test_iterator_set_initial_state_with_several_states_warns_and_takes_the_first(logs):
     it = _iterator([1], Out("next", outcomes=["next"]), contained={"loop_outcomes": ["next"]})
-    ud = smach.UserData()
-    ud.x = 1
+    ud = userdata(x=1)
     it.set_initial_state(["BODY", "OTHER"], ud)
     assert it.userdata.x == 1
     assert logs.warn == ["Attempting to set initial state to include more than one state, but the Iterator "

@@ -5,7 +5,7 @@ import threading
 import fsm as smach
 import pytest
 
-from smach_support import Out, concurrence, machine
+from smach_support import Out, concurrence, machine, userdata
 
 
 @pytest.mark.parametrize("log_fn, prefix", [
@@ -44,8 +44,7 @@ def test_set_loggers_reroutes_internal_logs(capsys, logs):
 
 def test_start_line_lists_userdata_keys_after_input_keys_are_copied(logs):
     sm = machine(["done"], [("FOO", Out("done"), {})], input_keys=["a"])
-    parent = smach.UserData()
-    parent.a = 1
+    parent = userdata(a=1)
     sm.execute(parent)
     assert logs.info[0] == "State machine starting in initial state 'FOO' with userdata: \n\t['a']"
 

@@ -3,7 +3,7 @@
 import fsm as smach
 import pytest
 
-from smach_support import Out, machine
+from smach_support import Out, machine, userdata
 
 
 def _run_one(fn, parent_data=None, remapping=None, **keys):
@@ -78,8 +78,7 @@ def test_keys_a_state_did_not_declare_are_invisible_to_it():
 
 @pytest.mark.parametrize("read", [lambda ud: ud.k, lambda ud: ud["k"], lambda ud: hasattr(ud, "k")])
 def test_reading_a_missing_key_logs_available_keys_and_raises_bare_key_error(logs, read):
-    ud = smach.UserData()
-    ud.a = 1
+    ud = userdata(a=1)
     with pytest.raises(KeyError) as info:
         read(ud)
     assert info.value.args == ()
@@ -169,9 +168,7 @@ def test_remapper_keys_lists_the_local_names_of_remapped_input_keys():
 def test_container_copies_declared_input_keys_on_entry_and_output_keys_on_exit():
     sm = machine(["done"], [("S", Out(lambda ud: setattr(ud, "b", ud.a * 2) or "done", input_keys=["a"],
                                       output_keys=["b"]), {})], input_keys=["a"], output_keys=["b"])
-    parent = smach.UserData()
-    parent.a = 4
-    parent.other = 0
+    parent = userdata(a=4, other=0)
     assert sm.execute(parent) == "done"
     assert parent.b == 8
     assert sm.userdata.keys() == ["a", "b"]

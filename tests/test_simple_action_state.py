@@ -216,8 +216,11 @@ def test_feedback_is_emitted_as_an_event_when_observed(bus, servers):
     server = serve(bus, servers, execute)
     sm = machine(["succeeded", "aborted", "preempted"], [("MOVE", state(bus), {})])
     events = []
-    smach.attach(sm, events.append)
-    assert sm.execute() == "succeeded"
+    rep = smach.attach(sm, events.append)
+    try:
+        assert sm.execute() == "succeeded"
+    finally:
+        rep.remove_observer(events.append)
     feedback = [e for e in events if e["kind"] == "feedback"]
     assert [(e["path"], e["action"]) for e in feedback] == [("/SM_ROOT/MOVE", "act")] * 2
     assert feedback[0]["feedback"] == {"distance": 0.12}

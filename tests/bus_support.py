@@ -2,7 +2,6 @@
 
 import time
 
-import fsm as smach
 import pytest
 from fsm.actionlib import SimpleActionServer
 from fsm.bus import Bus
@@ -51,10 +50,3 @@ def eventually(predicate, timeout: float = 1.0) -> bool:
         time.sleep(0.001)
     return True
 
-
-def ud_with(**values) -> smach.UserData:
-    """A top-level UserData holding ``values``, for running a state's execute directly."""
-    ud = smach.UserData()
-    for key, value in values.items():
-        ud[key] = value
-    return ud

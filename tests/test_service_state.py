@@ -7,10 +7,10 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus, eventually, ud_with  # noqa: F401 (fixture)
+from bus_support import bus, eventually  # noqa: F401 (fixture)
 from fsm.bus import default_bus
 from fsm.service_state import ServiceState
-from smach_support import Background, machine
+from smach_support import Background, machine, userdata
 
 
 def add_service(bus, name="add"):
@@ -41,7 +41,7 @@ def test_keys_and_slots_are_registered_as_input_and_output_keys(bus):
 
 def test_calls_with_the_given_request_and_stores_the_response(bus):
     add_service(bus)
-    ud = ud_with()
+    ud = userdata()
     state = ServiceState("add", request={"a": 1, "b": 2}, response_key="resp", bus=bus)
     assert state.execute(ud) == "succeeded"
     assert ud.resp.sum == 3
@@ -53,22 +53,22 @@ def test_default_request_is_built_from_the_spec_or_is_an_empty_dict(bus):
 
     class Request:
         pass
-    assert ServiceState("echo", Request, bus=bus).execute(ud_with()) == "succeeded"
-    assert ServiceState("echo", bus=bus).execute(ud_with()) == "succeeded"
+    assert ServiceState("echo", Request, bus=bus).execute(userdata()) == "succeeded"
+    assert ServiceState("echo", bus=bus).execute(userdata()) == "succeeded"
     assert isinstance(requests[0], Request) and requests[1] == {}
 
 
 def test_request_is_taken_from_the_request_key(bus):
     requests = add_service(bus)
     state = ServiceState("add", request_key="req", bus=bus)
-    assert state.execute(ud_with(req={"a": 5, "b": 6})) == "succeeded"
+    assert state.execute(userdata(req={"a": 5, "b": 6})) == "succeeded"
     assert requests == [{"a": 5, "b": 6}]
 
 
 def test_missing_request_key_aborts_with_an_error(bus, logs):
     add_service(bus)
     state = ServiceState("add", request_key="req", bus=bus)
-    assert state.execute(ud_with()) == "aborted"
+    assert state.execute(userdata()) == "aborted"
     assert "Requested request key 'req' not in userdata struture" in logs.error[0]
 
 
@@ -78,7 +78,7 @@ def test_request_slots_fill_dict_items_and_object_attributes(bus):
 
     class Request:
         a = b = None
-    ud = ud_with(a=1, b=2)
+    ud = userdata(a=1, b=2)
     assert ServiceState("echo", request_slots=["a", "b"], bus=bus).execute(ud) == "succeeded"
     assert ServiceState("echo", Request, request_slots=["a", "b"], bus=bus).execute(ud) == "succeeded"
     assert requests[0] == {"a": 1, "b": 2}
@@ -88,14 +88,14 @@ def test_request_slots_fill_dict_items_and_object_attributes(bus):
 def test_missing_request_slot_aborts_with_an_error(bus, logs):
     add_service(bus)
     state = ServiceState("add", request_slots=["a", "b"], bus=bus)
-    assert state.execute(ud_with(a=1)) == "aborted"
+    assert state.execute(userdata(a=1)) == "aborted"
     assert "Requested request slot key 'b' is not in userdata strcture" in logs.error[0]
 
 
 def test_request_cb_return_replaces_the_request_and_none_keeps_it(bus):
     requests = add_service(bus)
-    ServiceState("add", request_cb=lambda ud, req: {"a": 10, "b": 20}, bus=bus).execute(ud_with())
-    ServiceState("add", request={"a": 1, "b": 1}, request_cb=lambda ud, req: req.update(b=9), bus=bus).execute(ud_with())
+    ServiceState("add", request_cb=lambda ud, req: {"a": 10, "b": 20}, bus=bus).execute(userdata())
+    ServiceState("add", request={"a": 1, "b": 1}, request_cb=lambda ud, req: req.update(b=9), bus=bus).execute(userdata())
     assert requests == [{"a": 10, "b": 20}, {"a": 1, "b": 9}]
 
 
@@ -108,7 +108,7 @@ def test_request_cb_gets_its_args_and_sees_only_its_declared_keys(bus):
         return {"a": ud.x * scale, "b": offset}
     state = ServiceState("add", request_cb=request_cb, request_cb_args=[10], request_cb_kwargs={"offset": 3},
                          input_keys=["x"], response_slots=["sum"], bus=bus)
-    ud = ud_with(x=2, y=7)
+    ud = userdata(x=2, y=7)
     assert state.execute(ud) == "succeeded"
     assert seen == [["x"]] and ud.sum == 23
 
@@ -116,19 +116,19 @@ def test_request_cb_gets_its_args_and_sees_only_its_declared_keys(bus):
 def test_request_cb_exception_aborts(bus, logs):
     add_service(bus)
     state = ServiceState("add", request_cb=lambda ud, req: 1 / 0, bus=bus)
-    assert state.execute(ud_with()) == "aborted"
+    assert state.execute(userdata()) == "aborted"
     assert logs.error[0].startswith("Could not execute request callback: Traceback")
 
 
 def test_service_handler_exception_aborts(bus, logs):
     bus.advertise_service("bad", lambda req: 1 / 0)
-    assert ServiceState("bad", bus=bus).execute(ud_with()) == "aborted"
+    assert ServiceState("bad", bus=bus).execute(userdata()) == "aborted"
     assert logs.error[0].startswith("Exception when calling service 'bad': ")
 
 
 def test_response_slots_are_written_to_userdata(bus):
     add_service(bus)
-    ud = ud_with()
+    ud = userdata()
     assert ServiceState("add", request={"a": 2, "b": 2}, response_slots=["sum"], bus=bus).execute(ud) == "succeeded"
     assert ud.sum == 4
 
@@ -140,13 +140,13 @@ def test_response_cb_outcome_is_returned(bus):
     def response_cb(ud, response):
         return "big" if response.sum > 10 else None
     state = ServiceState("add", request={"a": 20, "b": 2}, response_cb=response_cb, bus=bus)
-    assert state.execute(ud_with()) == "big"
+    assert state.execute(userdata()) == "big"
 
 
 def test_unregistered_response_cb_outcome_aborts(bus, logs):
     add_service(bus)
     state = ServiceState("add", request={"a": 1, "b": 2}, response_cb=lambda ud, resp: "weird", bus=bus)
-    assert state.execute(ud_with()) == "aborted"
+    assert state.execute(userdata()) == "aborted"
     assert "was not registered with the response_cb_outcomes argument" in logs.error[0]
     assert "returned 'weird'" in logs.error[0]
 
@@ -154,7 +154,7 @@ def test_unregistered_response_cb_outcome_aborts(bus, logs):
 def test_response_cb_exception_aborts(bus, logs):
     add_service(bus)
     state = ServiceState("add", request={"a": 1, "b": 2}, response_cb=lambda ud, resp: 1 / 0, bus=bus)
-    assert state.execute(ud_with()) == "aborted"
+    assert state.execute(userdata()) == "aborted"
     assert logs.error[0].startswith("Could not execute response callback: ")
 
 
@@ -167,7 +167,7 @@ def test_preempt_before_execute_gives_preempted_without_calling(bus, logs):
     requests = add_service(bus)
     state = ServiceState("add", request={"a": 1, "b": 2}, bus=bus)
     state.request_preempt()
-    assert state.execute(ud_with()) == "preempted"
+    assert state.execute(userdata()) == "preempted"
     assert not state.preempt_requested() and requests == []
     assert "Preempting add before sending request." in logs.info
 
@@ -175,12 +175,12 @@ def test_preempt_before_execute_gives_preempted_without_calling(bus, logs):
 def test_waits_for_a_service_that_comes_up_later(bus):
     threading.Timer(0.05, add_service, (bus,)).start()
     state = ServiceState("add", request={"a": 1, "b": 2}, bus=bus)
-    assert state.execute(ud_with()) == "succeeded"
+    assert state.execute(userdata()) == "succeeded"
 
 
 def test_preempt_while_waiting_for_the_service_gives_preempted_at_once(bus, logs):
     state = ServiceState("missing", bus=bus)
-    run = Background(lambda: state.execute(ud_with()))
+    run = Background(lambda: state.execute(userdata()))
     assert eventually(lambda: logs.warn)
     t0 = time.monotonic()
     state.request_preempt()
@@ -192,7 +192,7 @@ def test_preempt_while_waiting_for_the_service_gives_preempted_at_once(bus, logs
 
 def test_shutdown_while_waiting_for_the_service_aborts(bus, logs):
     smach.set_shutdown_check(lambda: True)
-    assert ServiceState("missing", bus=bus).execute(ud_with()) == "aborted"
+    assert ServiceState("missing", bus=bus).execute(userdata()) == "aborted"
     assert "Terminated while waiting for service 'missing'." in logs.warn
 
 
@@ -210,7 +210,7 @@ def test_in_a_state_machine_slots_go_through_remapping(bus, logs):
 def test_uses_the_default_bus_when_none_is_given():
     handle = default_bus.advertise_service("default_add", lambda req: "ok")
     try:
-        ud = ud_with()
+        ud = userdata()
         assert ServiceState("default_add", response_key="r").execute(ud) == "succeeded"
         assert ud.r == "ok"
     finally:

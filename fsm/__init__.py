@@ -12,14 +12,21 @@ from .concurrence import Concurrence
 from .sequence import Sequence
 from .iterator import Iterator
 from .introspection import attach, add_global_hook, remove_global_hook, Reporter
+from . import bus
+from .bus import Bus, ServiceException, get_bus
+from .actionlib import GoalStatus, SimpleActionServer, SimpleActionClient
+from .service_state import ServiceState
+from .simple_action_state import SimpleActionState
+from .monitor_state import MonitorState
+from .condition_state import ConditionState
+from .recorder import Recorder
 
 __all__ = [
     "loginfo", "logwarn", "logerr", "logdebug", "set_loggers", "is_shutdown", "set_shutdown_check",
     "SmachError", "InvalidTransitionError", "InvalidStateError", "InvalidConstructionError", "InvalidUserCodeError",
     "has_smach_interface", "cb_interface", "CBInterface", "UserData", "Remapper", "Const", "get_const",
     "State", "CBState", "Container", "StateMachine", "Concurrence", "Sequence", "Iterator",
-    "attach", "add_global_hook", "remove_global_hook", "Reporter",
+    "attach", "add_global_hook", "remove_global_hook", "Reporter", "Recorder",
+    "bus", "Bus", "ServiceException", "get_bus", "GoalStatus", "SimpleActionServer", "SimpleActionClient",
+    "ServiceState", "SimpleActionState", "MonitorState", "ConditionState",
 ]
-
-from .recorder import Recorder  # noqa: E402  (recording: fsm.attach(sm, fsm.Recorder("run.jsonl")))
-__all__.append("Recorder")

@@ -1,0 +1,296 @@
+"""Server benchmarks (medians): event-to-browser latency, fan-out throughput against a bare `websockets`
+server, a machine's transition rate with a stalled client, and the server's memory during the stall.
+
+    .venv/bin/python bench/server.py [--repeat 3] [--stall-seconds 60]
+
+Clients run in a separate process (so they do not share the server's GIL); latency is the client's
+``time.time()`` on receipt minus the event's ``t`` (same host clock).
+Targets: p99 < 5 ms at 1,000 events/s to 10 clients; >= 0.8 of the bare server's events/s per client with
+50 clients; <= 5 % fewer transitions/s with one stalled client; memory bounded during a stall.
+"""
+
+import argparse
+import asyncio
+import json
+import multiprocessing as mp
+import os
+import resource
+import socket
+import statistics
+import sys
+import threading
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+
+import fsm  # noqa: E402
+from fsm.encoding import dumps  # noqa: E402
+from server.introspection_server import ServerThread  # noqa: E402
+
+
+def rss_mb():
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+# Clients (in a child process).
+
+def _clients(url, n, expect, out, ready):
+    async def one(i):
+        from websockets.asyncio.client import connect
+        lat, count, first, last = [], 0, None, None
+        async with connect(url, compression=None, max_size=None) as ws:
+            ready.put(i)
+            while True:
+                try:
+                    frame = json.loads(await asyncio.wait_for(ws.recv(), 3))
+                except asyncio.TimeoutError:
+                    break
+                now = time.time()
+                if frame.get("type") == "events":
+                    evs = frame["events"]
+                elif frame.get("kind"):  # the bare server sends events as they are
+                    evs = [frame]
+                else:
+                    continue
+                for ev in evs:
+                    if ev.get("kind") != "log":
+                        continue
+                    if ev["msg"] == "end":
+                        return lat, count, first, last
+                    if first is None:
+                        first = now
+                    last = now
+                    count += 1
+                    lat.append(now - ev["t"])
+        return lat, count, first, last
+
+    async def main():
+        return await asyncio.gather(*(one(i) for i in range(n)))
+    out.put(asyncio.run(main()))
+
+
+def run_clients(url, n, expect):
+    ctx = mp.get_context("spawn")
+    out, ready = ctx.Queue(), ctx.Queue()
+    proc = ctx.Process(target=_clients, args=(url, n, expect, out, ready), daemon=True)
+    proc.start()
+    for _ in range(n):
+        ready.get(timeout=30)
+    return proc, out
+
+
+def emit_paced(rep, path, n, rate):
+    """Emit n log events through the machine's reporter at ``rate``/s (rate 0: as fast as possible)."""
+    start = time.perf_counter()
+    for i in range(n):
+        if rate:  # sleep (releasing the GIL, as a machine waiting on the world does) until the event is due
+            delay = start + i / rate - time.perf_counter()
+            if delay > 0:
+                time.sleep(delay)
+        rep.emit("log", path, {"level": "info", "msg": "tick %d" % i})
+    rep.emit("log", path, {"level": "info", "msg": "end"})
+
+
+def make_machine():
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "done"})
+    return sm
+
+
+def fsmscope_run(n_clients, n_events, rate):
+    srv = ServerThread().start()
+    entry = srv.hub.add_local(make_machine(), name="bench")
+    url = "ws://127.0.0.1:%d/api/machines/bench/stream?token=%s" % (srv.port, srv.token)
+    proc, out = run_clients(url, n_clients, n_events)
+    time.sleep(0.3)
+    emit_paced(entry.reporter, "/SM_ROOT", n_events, rate)
+    results = out.get(timeout=120)
+    proc.join(10)
+    srv.stop()
+    return results
+
+
+def bare_run(n_clients, n_events, rate):
+    """The same events, hand-off and fan-out on a bare `websockets` server: one frame per event per client."""
+    from websockets.asyncio.server import broadcast, serve
+
+    clients = set()
+    state = {}
+    started = threading.Event()
+
+    async def handler(ws):
+        clients.add(ws)
+        try:
+            await ws.wait_closed()
+        finally:
+            clients.discard(ws)
+
+    async def main():
+        state["loop"] = asyncio.get_running_loop()
+        state["stop"] = asyncio.Event()
+        async with serve(handler, "127.0.0.1", 0, compression=None) as server:
+            state["port"] = server.sockets[0].getsockname()[1]
+            started.set()
+            await state["stop"].wait()
+
+    thread = threading.Thread(target=lambda: asyncio.run(main()), daemon=True)
+    thread.start()
+    started.wait(10)
+    loop = state["loop"]
+    sm = make_machine()
+    buf = []
+
+    def drain():
+        while buf:
+            broadcast(clients, dumps(buf.pop(0)).decode())
+
+    rep = fsm.attach(sm, lambda ev: (buf.append(ev), loop.call_soon_threadsafe(drain)), name="bare")
+    proc, out = run_clients("ws://127.0.0.1:%d/" % state["port"], n_clients, n_events)
+    time.sleep(0.3)
+    emit_paced(rep, "/SM_ROOT", n_events, rate)
+    results = out.get(timeout=120)
+    proc.join(10)
+    loop.call_soon_threadsafe(state["stop"].set)
+    thread.join(5)
+    return results
+
+
+def pct(values, p):
+    values = sorted(values)
+    return values[min(len(values) - 1, int(p / 100 * len(values)))]
+
+
+def rate_per_client(results):
+    return [count / (last - first) for _, count, first, last in results if last and last > first]
+
+
+# Transition rate with a stalled client.
+
+def loop_machine(n):
+    counter = [0]
+
+    def step(ud):
+        counter[0] += 1
+        return "again" if counter[0] < n else "stop"
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(step, outcomes=["again", "stop"]), {"again": "B", "stop": "done"})
+        fsm.StateMachine.add("B", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "A"})
+    return sm, counter
+
+
+def stalled_socket(srv, name):
+    raw = socket.create_connection(("127.0.0.1", srv.port))
+    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    raw.sendall(("GET /api/machines/%s/stream?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
+                 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13"
+                 "\r\n\r\n" % (name, srv.token, srv.port)).encode())
+    raw.recv(100)
+    return raw
+
+
+def transition_rate(stalled, n=100_000):
+    srv = ServerThread().start()
+    sm, counter = loop_machine(n)
+    entry = srv.hub.add_local(sm, name="loop")
+    raw = stalled_socket(srv, "loop") if stalled else None
+    time.sleep(0.2)
+    t = time.perf_counter()
+    sm.execute()
+    elapsed = time.perf_counter() - t
+    if raw is not None:
+        raw.close()
+    srv.stop()
+    return counter[0] * 2 / elapsed
+
+
+def stall_memory(seconds):
+    """A machine looping with a paced sleep-free workload for ``seconds`` while a client never reads."""
+    srv = ServerThread().start()
+    stop = threading.Event()
+
+    def step(ud):
+        ud.blob = "x" * 500
+        time.sleep(0.0002)
+        return "stop" if stop.is_set() else "again"
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(step, outcomes=["again", "stop"], output_keys=["blob"]),
+                             {"again": "A", "stop": "done"})
+    entry = srv.hub.add_local(sm, name="stall")
+    raw = stalled_socket(srv, "stall")
+    thread = threading.Thread(target=sm.execute, daemon=True)
+    before = rss_mb()
+    thread.start()
+    samples = []
+    for _ in range(int(seconds)):
+        time.sleep(1)
+        samples.append(rss_mb())
+    stop.set()
+    thread.join(10)
+    events = entry.reporter.last_seq
+    clients = len(entry.clients)
+    raw.close()
+    srv.stop()
+    return before, samples, events, clients
+
+
+def main():
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--stall-seconds", type=float, default=60)
+    args = parser.parse_args()
+    print("fsmscope server benchmarks, median of %d runs, cores=%d\n" % (args.repeat, os.cpu_count()))
+
+    p50s, p99s, maxs = [], [], []
+    for _ in range(args.repeat):
+        results = fsmscope_run(10, 3000, 1000)
+        lat = [x for r in results for x in r[0]]
+        p50s.append(pct(lat, 50) * 1000)
+        p99s.append(pct(lat, 99) * 1000)
+        maxs.append(max(lat) * 1000)
+    print("| event-to-client latency, 1,000 events/s, 10 clients | p50 ms | p99 ms | max ms | target |")
+    print("|---|---|---|---|---|")
+    print("| fsmscope | %.2f | %.2f | %.2f | p99 < 5 ms: %s |\n" % (statistics.median(p50s), statistics.median(p99s),
+                                                             statistics.median(maxs),
+                                                             "met" if statistics.median(p99s) < 5 else "MISSED"))
+
+    ours, bare = [], []
+    for _ in range(args.repeat):
+        ours.append(statistics.median(rate_per_client(fsmscope_run(50, 15000, 5000))))
+        bare.append(statistics.median(rate_per_client(bare_run(50, 15000, 5000))))
+    ratio = statistics.median(ours) / statistics.median(bare)
+    print("| fan-out, 15,000 events at 5,000/s, 50 clients | events/s per client (median) | ratio |")
+    print("|---|---|---|")
+    print("| bare websockets server (one frame per event, broadcast) | %.0f | 1.00 |" % statistics.median(bare))
+    print("| fsmscope (FastAPI + uvicorn, batched under load) | %.0f | %.2f (target >= 0.8: %s) |\n"
+          % (statistics.median(ours), ratio, "met" if ratio >= 0.8 else "MISSED"))
+
+    none, stalled = [], []
+    for _ in range(args.repeat):
+        none.append(transition_rate(False))
+        stalled.append(transition_rate(True))
+    drop = 1 - statistics.median(stalled) / statistics.median(none)
+    print("| machine transitions/s (two-state loop, hub attached) | transitions/s | |")
+    print("|---|---|---|")
+    print("| no client | %.0f | |" % statistics.median(none))
+    print("| one stalled client | %.0f | %.1f %% lower (target <= 5 %%: %s) |\n"
+          % (statistics.median(stalled), drop * 100, "met" if drop <= 0.05 else "MISSED"))
+
+    before, samples, events, clients = stall_memory(args.stall_seconds)
+    print("| stalled client for %.0f s (machine emitting ~%.0f events/s) | RSS MB |" % (args.stall_seconds,
+                                                                                    events / args.stall_seconds))
+    print("|---|---|")
+    print("| before | %.1f |" % before)
+    for s in sorted({min(len(samples) - 1, k) for k in (0, 9, 29, len(samples) - 1)}):
+        print("| after %d s | %.1f |" % (s + 1, samples[s]))
+    print("| stalled client still connected at the end | %s |" % ("yes" if clients else "no (evicted)"))
+
+
+if __name__ == "__main__":
+    main()

@@ -3,6 +3,7 @@
 import fsm as smach
 import fsm.log
 import pytest
+from fsm import introspection
 
 from smach_support import Out, WaitForPreempt, concurrence, machine, preempt_while_running
 
@@ -22,6 +23,13 @@ def observe():
     yield attach
     for rep, observer in attached:
         rep.remove_observer(observer)
+
+
+@pytest.fixture
+def nobody_listening(monkeypatch):
+    """Hide reporters that other tests left attached, so the global log listener reflects this test alone."""
+    monkeypatch.setattr(introspection, "_listening", set())
+    monkeypatch.setattr(fsm.log, "listener", None)
 
 
 def _fields(events, expected):
@@ -239,7 +247,7 @@ def test_runtime_start_transition_and_termination_lines_are_not_log_events(obser
     assert [e for e in events if e["kind"] == "log"] == []
 
 
-def test_without_an_observer_there_are_no_events_and_no_log_listener():
+def test_without_an_observer_there_are_no_events_and_no_log_listener(nobody_listening):
     seen_listener = []
     sm = machine(["done"], [("A", Out(lambda ud: seen_listener.append(fsm.log.listener) or "done"), {})])
     rep = smach.attach(sm)
@@ -249,7 +257,7 @@ def test_without_an_observer_there_are_no_events_and_no_log_listener():
     assert fsm.log.listener is None
 
 
-def test_removing_the_last_observer_clears_the_log_listener():
+def test_removing_the_last_observer_clears_the_log_listener(nobody_listening):
     sm = _nested()
     events = []
     rep = smach.attach(sm, events.append)

@@ -5,7 +5,6 @@ from typing import Any, Callable, Iterable
 
 from . import introspection, log
 from .container import Container
-from .encoding import encode
 from .exceptions import InvalidUserCodeError
 from .state import State
 
@@ -75,17 +74,11 @@ class Iterator(Container):
         outcome = self._exhausted_outcome
         state_outcome = None
         rep = self._reporter
-        looped = None  # while observed: the outcome of a looping iteration, reported once the next item is known
         while not log.is_shutdown():
             try:
                 item = next(it)
             except Exception:  # any failure of the iterable counts as exhaustion, as in SMACH
                 break
-            if looped is not None:
-                rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(looped),
-                                                    "to": str(self._state_label), "active": [str(self._state_label)],
-                                                    "item": encode(item)})
-                looped = None
             log.loginfo("Iterating %s of %s" % (str(item), str(items)))
             self.userdata[self._items_label] = item
             try:
@@ -106,7 +99,8 @@ class Iterator(Container):
                 outcome = self._final_outcome_map.get(state_outcome, state_outcome)
                 break
             if rep is not None:
-                looped = state_outcome
+                rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(state_outcome),
+                                                    "to": str(self._state_label), "active": [str(self._state_label)]})
             self.call_transition_cbs()
         self._copy_output_keys(self.userdata, parent_ud)
         self._is_running = False

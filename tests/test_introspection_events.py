@@ -134,16 +134,16 @@ def test_concurrence_events_report_children_finishing_and_their_outcomes(observe
     assert _fields(cc_events[-1:], expected) == expected
 
 
-def test_iterator_transition_events_carry_the_next_item(observe):
-    it = smach.Iterator(outcomes=["done"], input_keys=[], output_keys=[], it=[1, 2, 3])
+def test_iterator_reports_each_looping_iteration_with_its_item_as_a_userdata_change(observe):
+    it = smach.Iterator(outcomes=["done"], input_keys=[], output_keys=[], it=[1, 2])
     with it:
         smach.Iterator.set_contained_state("BODY", Out("next", outcomes=["next"]), loop_outcomes=["next"])
     sm = machine(["done", "exhausted"], [("IT", it, {})])
     events = observe(sm)
     assert sm.execute() == "exhausted"
-    steps = [e for e in events if e["path"] == "/SM_ROOT/IT" and e["kind"] == "transition"]
-    expected = [{"from": "BODY", "outcome": "next", "to": "BODY", "active": ["BODY"], "item": 2},
-                {"from": "BODY", "outcome": "next", "to": "BODY", "active": ["BODY"], "item": 3}]
+    steps = [e for e in events if e["path"] == "/SM_ROOT/IT" and e["kind"] in ("userdata", "transition")]
+    step = {"from": "BODY", "outcome": "next", "to": "BODY", "active": ["BODY"]}
+    expected = [{"changes": {"it_data": 1}}, step, {"changes": {"it_data": 2}}, step]
     assert _fields(steps, expected) == expected
 
 

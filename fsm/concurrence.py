@@ -48,6 +48,7 @@ class Concurrence(Container):
         self._child_termination_cb = child_termination_cb
         self._child_outcomes: dict[str, Any] = {}
         self._failed: dict[str, BaseException] = {}
+        self._failed_label: str | None = None  # the child whose failure ended the last run
         self._pending = 0
         self._done_cond = threading.Condition()
         self._is_running = False
@@ -64,7 +65,7 @@ class Concurrence(Container):
         try:
             return self._execute(parent_ud)
         except BaseException as exc:
-            self._report_error(None, exc)
+            self._report_error(self._failed_label, exc)
             raise
         finally:
             introspection.leave(ctx)
@@ -76,6 +77,7 @@ class Concurrence(Container):
         with self._done_cond:
             self._child_outcomes = dict.fromkeys(states)
             self._failed = {}
+            self._failed_label = None
             self._pending = len(states)
         self._copy_input_keys(parent_ud, self.userdata)
         log.info_quiet("Concurrence starting with userdata: \n\t%s" % str(list(self.userdata.keys())))
@@ -147,7 +149,7 @@ class Concurrence(Container):
         failed = self._failed
         self._failed = {}
         self._child_outcomes = {}
-        first = next(iter(failed.values()))
+        self._failed_label, first = next(iter(failed.items()))
         if isinstance(first, (InvalidStateError, InvalidUserCodeError)) and getattr(first, "_fsm_own", False):
             raise first
         raise introspection.carry_reported(

@@ -137,8 +137,7 @@ class Container(State):
         if rep is None:
             return
         if not getattr(exc, "_fsm_reported", False):
-            tb = "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))
-            rep.emit("error", self._path, introspection.error_fields(label, exc, tb))
+            rep.emit("error", self._path, introspection.error_fields(label, exc))
             try:
                 exc._fsm_reported = True
             except AttributeError:

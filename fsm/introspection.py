@@ -200,6 +200,13 @@ def carry_reported(error: BaseException, cause: BaseException) -> BaseException:
     return error
 
 
-def error_fields(state_label: Any, exc: BaseException, tb: str) -> dict:
-    return {"state": None if state_label is None else str(state_label), "exc_type": type(exc).__name__,
-            "message": str(exc), "traceback": tb}
+def error_fields(state_label: Any, exc: BaseException) -> dict:
+    """Describe the root cause (the user's own exception), not SMACH's wrapper around it."""
+    root = exc
+    while root.__cause__ is not None:
+        root = root.__cause__
+    fields = {"state": None if state_label is None else str(state_label), "exc_type": type(root).__name__,
+              "message": str(root), "traceback": "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))}
+    if root is not exc:
+        fields["wrapped_as"] = type(exc).__name__
+    return fields

@@ -88,7 +88,7 @@ class Iterator(Container):
             except Exception as exc:
                 raise introspection.carry_reported(InvalidUserCodeError(
                     "Could not execute iterator state '%s' of type '%s': " % (self._state_label, self._state)
-                    + traceback.format_exc()), exc)
+                    + traceback.format_exc()), exc) from exc
             if rep is not None:
                 self._report_changes()
             if self._preempt_requested:

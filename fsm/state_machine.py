@@ -129,7 +129,7 @@ class StateMachine(Container):
             raise ex
         except Exception as exc:
             raise introspection.carry_reported(InvalidUserCodeError(
-                "Could not execute state '%s' of type '%s': " % (last_state_label, state) + traceback.format_exc()), exc)
+                "Could not execute state '%s' of type '%s': " % (last_state_label, state) + traceback.format_exc()), exc) from exc
         finally:
             lock.acquire()
 

@@ -159,7 +159,7 @@ def test_nested_error_emits_exactly_one_error_event_from_the_innermost_container
     assert len(errors) == 1
     error = errors[0]
     assert (error["path"], error["state"]) == ("/SM_ROOT/SUB", "BAD")
-    assert (error["exc_type"], error["message"]) == (type(info.value).__name__, str(info.value))
+    assert (error["exc_type"], error["message"], error["wrapped_as"]) == ("ValueError", "boom", type(info.value).__name__)
     assert error["traceback"].startswith("Traceback (most recent call last):")
     assert "ValueError: boom" in error["traceback"]
     terminates = [e for e in events if e["kind"] == "terminate"]
@@ -175,7 +175,7 @@ def test_concurrence_child_error_emits_one_error_event(observe, logs):
     with pytest.raises(smach.InvalidUserCodeError):  # the machine wraps the Concurrence's InvalidStateError
         sm.execute()
     errors = [e for e in events if e["kind"] == "error"]
-    assert [(e["path"], e["exc_type"]) for e in errors] == [("/SM_ROOT/CC", "InvalidStateError")]
+    assert [(e["path"], e["state"], e["exc_type"]) for e in errors] == [("/SM_ROOT/CC", "BAD", "ZeroDivisionError")]
     assert "ZeroDivisionError" in errors[0]["traceback"]
 
 

@@ -63,7 +63,7 @@ def test_a_run_ending_in_an_error_lists_it_and_exits_1(tmp_path):
     summary = summarize(read_events(path))
     m = summary.to_dict()["machines"]["m"]
     assert m["status"] == ERROR and m["outcome"] is None
-    assert [(e["state"], e["exc_type"]) for e in m["errors"]] == [("BAD", "InvalidUserCodeError")]
+    assert [(e["state"], e["exc_type"]) for e in m["errors"]] == [("BAD", "ValueError")]
     assert summary.exit_code() == 1
 
 

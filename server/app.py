@@ -123,6 +123,10 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     async def health() -> models.Health:
         return models.Health(ok=True)
 
+    @app.get("/api/scene", response_model=models.Scene, dependencies=auth, responses=ERRORS, tags=["meta"])
+    async def scene() -> models.Scene:
+        return models.Scene(url=hub.scene_url)
+
     @app.get("/api/machines", response_model=list[models.MachineInfo], dependencies=auth, responses=ERRORS,
              tags=["machines"])
     async def list_machines() -> list[dict]:

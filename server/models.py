@@ -17,6 +17,11 @@ class Health(BaseModel):
     ok: bool = True
 
 
+class Scene(BaseModel):
+    """Where the 3D view of the simulated robot is served (None: this server has none)."""
+    url: str | None = None
+
+
 class MachineInfo(BaseModel):
     name: str
     running: bool

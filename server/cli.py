@@ -82,6 +82,19 @@ def serve(args: argparse.Namespace) -> int:
     return serve_main(args)
 
 
+# fsmscope demo
+
+def _demo_arguments(parser: argparse.ArgumentParser) -> None:
+    from sim.demo import add_arguments  # light: mujoco and viser load only when the demo runs
+    add_arguments(parser)
+
+
+@subcommand("demo", "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view", _demo_arguments)
+def demo(args: argparse.Namespace) -> int:
+    from sim.demo import run_demo
+    return run_demo(args)
+
+
 # fsmscope replay
 
 def _replay_arguments(parser: argparse.ArgumentParser) -> None:

@@ -2,9 +2,9 @@
 
 import { api, ApiError } from "./api.js";
 import { Stream } from "./stream.js";
-import { Status, containers, allNodes } from "./status.js";
+import { Status, containers, allNodes, parentPath } from "./status.js";
 import { GraphView } from "./graph.js";
-import { TreeView, UserdataPanel, EventLog, parentPath } from "./panels.js";
+import { TreeView, UserdataPanel, EventLog } from "./panels.js";
 import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
 
 const $ = (id) => document.getElementById(id);

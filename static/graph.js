@@ -3,6 +3,8 @@
 // (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME), so the layout never moves when
 // only the status changes. Pan (drag) and zoom (wheel) act on the SVG's viewBox.
 
+import { parentPath } from "./status.js";
+
 const SVG_NS = "http://www.w3.org/2000/svg";
 const MAX_FIT_SCALE = 1.7; // px per SVG unit (pt): about 1.3 times Graphviz's natural size
 const DROP_ELEMENTS = new Set(["script", "foreignobject", "iframe", "object", "embed", "image", "use", "animate",
@@ -44,11 +46,6 @@ export function parseSvg(text) {
   }
   sanitizeSvg(svg);
   return document.importNode(svg, true);
-}
-
-function parentPath(path) {
-  const i = path.lastIndexOf("/");
-  return i > 0 ? path.slice(0, i) : null;
 }
 
 export class GraphView {

@@ -1,6 +1,7 @@
 // The side panels: the hierarchy tree, a container's userdata, the event log.
 // Every name, value and message goes in as text (createElement + textContent), never as HTML.
 
+import { parentPath } from "./status.js";
 import { transcript, valueText } from "./transcript.js";
 
 export function h(tag, props = {}, ...children) {
@@ -15,11 +16,6 @@ export function h(tag, props = {}, ...children) {
   }
   for (const child of children) if (child !== null && child !== undefined) el.append(child);
   return el;
-}
-
-export function parentPath(path) {
-  const i = path.lastIndexOf("/");
-  return i > 0 ? path.slice(0, i) : null;
 }
 
 /** The tree of the hierarchy; rows are built once per structure, status only toggles classes. */

@@ -7,6 +7,12 @@ function containerEntry(initial) {
   return { active: [], initial: [...(initial || [])], userdata: {}, running: false, outcome: null };
 }
 
+/** The path of the container holding `path` (null for the root). */
+export function parentPath(path) {
+  const i = path.lastIndexOf("/");
+  return i > 0 ? path.slice(0, i) : null;
+}
+
 /** Every container node of a structure tree, parents first. */
 export function* containers(node) {
   if (node && node.container) {

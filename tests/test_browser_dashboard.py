@@ -347,12 +347,15 @@ def test_js_reducer_matches_python(page):
         if event["kind"] == "transition" and event.get("to") == "COUNT":
             lap.set()
 
-    fsm.attach(sm, observe, name="lap")
+    reporter = fsm.attach(sm, observe, name="lap")
     runner = threading.Thread(target=sm.execute)
     runner.start()
-    assert lap.wait(10)
-    sm.request_preempt()  # from another thread, as the server does
-    runner.join(10)
+    try:
+        assert lap.wait(10)
+    finally:
+        sm.request_preempt()  # from another thread, as the server does
+        runner.join(10)
+        reporter.remove_observer(observe)  # leave no log listener behind for other tests
     want = rebuild(events)["lap"].to_dict()
     got = page.evaluate("""async (events) => {
         const { Status } = await import('/status.js');

@@ -39,6 +39,7 @@ const machine = (name) => "/api/machines/" + encodeURIComponent(name);
 export const api = {
   health: () => request("GET", "/api/health"),
   machines: () => request("GET", "/api/machines"),
+  scene: () => request("GET", "/api/scene"),
   structure: (name) => request("GET", machine(name) + "/structure"),
   status: (name) => request("GET", machine(name) + "/status"),
   graphSvg(name, expand) {

@@ -6,6 +6,7 @@ import { Status, containers, allNodes, parentPath } from "./status.js";
 import { GraphView } from "./graph.js";
 import { TreeView, UserdataPanel, EventLog } from "./panels.js";
 import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
+import { SceneView } from "./scene.js";
 
 const $ = (id) => document.getElementById(id);
 const MACHINE_POLL_MS = 2000;
@@ -52,6 +53,7 @@ const log = new EventLog($("log"), {
   kind: $("log-kind"), path: $("log-path"), count: $("log-count"), clear: $("log-clear"),
 }, { select: (path) => select(path) });
 log.nodeOf = (path) => app.nodes.get(path);
+const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"));
 
 // ---------------------------------------------------------------- notices
 
@@ -83,6 +85,7 @@ async function pollMachines() {
     banner("");
     app.machines = Array.isArray(list) ? list : [];
     fillPicker();
+    if (!scene.url) api.scene().then((s) => scene.show(s && s.url)).catch(() => {});
     if (!app.name || !app.machines.some((m) => m.name === app.name)) {
       const wanted = decodeURIComponent((location.hash.match(/m=([^&]*)/) || [])[1] || "");
       const pick = app.machines.find((m) => m.name === wanted) || app.machines.find((m) => m.running) || app.machines[0];

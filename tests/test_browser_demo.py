@@ -1,0 +1,76 @@
+"""The demo page as a user sees it: `fsmscope demo` as a real process, Debian's Chromium."""
+
+from __future__ import annotations
+
+import io
+import os
+import time
+
+import pytest
+from browser_support import CHROMIUM, DemoProcess, launch_chromium
+
+# The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
+# clearly red > green > blue.
+def is_arm_orange(r: int, g: int, b: int) -> bool:
+    return r > 120 and r - b > 90 and r > g > b and g - b > 25
+
+
+ACTIVE_LEAF = """() => {
+    const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
+    ids.sort((a, b) => b.length - a.length);
+    return ids[0] || null;
+}"""
+
+
+@pytest.fixture(scope="module")
+def demo(tmp_path_factory):
+    if not os.path.exists(CHROMIUM):
+        pytest.skip("Debian's chromium is not installed (make apt)")
+    process = DemoProcess(tmp_path_factory.mktemp("demo") / "demo.jsonl")
+    yield process
+    assert process.stop() == 130  # interrupted, cleanly
+
+
+@pytest.fixture(scope="module")
+def page(demo):
+    playwright_api = pytest.importorskip("playwright.sync_api")
+    with playwright_api.sync_playwright() as pw:
+        browser = launch_chromium(pw)
+        page = browser.new_page(viewport={"width": 1600, "height": 900})
+        page.set_default_timeout(20000)
+        page.goto(demo.url)
+        page.wait_for_selector("#badge.live")
+        page.wait_for_selector("#graph svg")
+        yield page
+        browser.close()
+
+
+@pytest.mark.timeout(90)
+def test_demo_page_draws_the_arm_in_the_3d_view(page):
+    page.wait_for_selector("#scene-pane:not([hidden]) iframe")
+    scene = page.frame_locator("#scene-pane iframe")
+    scene.locator("canvas").first.wait_for(state="visible")
+    from PIL import Image
+
+    deadline = time.monotonic() + 30
+    orange = 0
+    while time.monotonic() < deadline:
+        shot = Image.open(io.BytesIO(page.locator("#scene-pane .scene").screenshot())).convert("RGB")
+        orange = sum(1 for pixel in shot.getdata() if is_arm_orange(*pixel))
+        if orange > 200:
+            break
+        time.sleep(1.0)
+    assert orange > 200, "no arm-coloured pixels in the 3D view"
+
+
+@pytest.mark.timeout(90)
+def test_demo_graph_highlights_the_running_state_as_the_arm_moves(page):
+    page.wait_for_function(f"({ACTIVE_LEAF})() !== null")
+    seen = {page.evaluate(ACTIVE_LEAF)}
+    deadline = time.monotonic() + 30
+    while len(seen) < 3 and time.monotonic() < deadline:
+        time.sleep(0.2)
+        seen.add(page.evaluate(ACTIVE_LEAF))
+    seen.discard(None)
+    assert len(seen) >= 3, seen
+    assert all(node.startswith("s:/SM_ROOT/") for node in seen)

@@ -20,6 +20,8 @@ from .worker_pool import pool
 
 
 class Concurrence(Container):
+    _kind_name = "Concurrence"
+
     def __init__(self, outcomes: Any, default_outcome: str, input_keys: list[str] = [], output_keys: list[str] = [],
                  outcome_map: dict = {}, outcome_cb: Callable | None = None,
                  child_termination_cb: Callable | None = None) -> None:
@@ -60,15 +62,8 @@ class Concurrence(Container):
         self._remappings[label] = remapping
         return state
 
-    def execute(self, parent_ud: Any = None) -> Any:
-        ctx = self._report_start(parent_ud)
-        try:
-            return self._execute(parent_ud)
-        except BaseException as exc:
-            self._report_error(self._failed_label, exc)
-            raise
-        finally:
-            introspection.leave(ctx)
+    def _on_failure(self) -> Any:
+        return self._failed_label
 
     def _execute(self, parent_ud: Any) -> Any:
         if not self._states:
@@ -219,13 +214,6 @@ class Concurrence(Container):
 
     def get_children(self) -> dict:
         return self._states
-
-    def __getitem__(self, key: str) -> State:
-        if key not in self._states:
-            log.logerr("Attempting to get state '%s' from Concurrence container. The only available states are: %s"
-                       % (key, str(list(self._states.keys()))))
-            raise KeyError()
-        return self._states[key]
 
     def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
         """Every child is initial; fixed against SMACH (a TypeError on Python 3): merges the userdata."""

@@ -25,9 +25,35 @@ class Container(State):
         self._transition_cbs: list[tuple] = []
         self._termination_cbs: list[tuple] = []
 
+    # What SMACH's error messages call this kind of container.
+    _kind_name = "Container"
+
+    def execute(self, parent_ud: Any = None) -> Any:
+        """Run ``_execute`` between the introspection bookkeeping of a start and an end."""
+        ctx = self._report_start(parent_ud)
+        try:
+            return self._execute(parent_ud)
+        except BaseException as exc:
+            self._report_error(self._on_failure(), exc)
+            raise
+        finally:
+            introspection.leave(ctx)
+
+    def _execute(self, parent_ud: Any) -> Any:
+        raise NotImplementedError()
+
+    def _on_failure(self) -> Any:
+        """A run raised: undo what the run set; returns the label of the child that failed, if known."""
+        return None
+
     # The interface every container implements.
     def __getitem__(self, key: str) -> State:
-        raise NotImplementedError()
+        children = self.get_children()
+        if key not in children:
+            log.logerr("Attempting to get state '%s' from %s container. The only available states are: %s"
+                       % (key, self._kind_name, str(list(children.keys()))))
+            raise KeyError()
+        return children[key]
 
     def get_children(self) -> dict:
         raise NotImplementedError()

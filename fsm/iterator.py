@@ -10,6 +10,8 @@ from .state import State
 
 
 class Iterator(Container):
+    _kind_name = "Iterator"
+
     def __init__(self, outcomes: list[str], input_keys: list[str], output_keys: list[str],
                  it: Iterable | Callable[[], Iterable] = [], it_label: str = "it_data",
                  exhausted_outcome: str = "exhausted") -> None:
@@ -53,16 +55,9 @@ class Iterator(Container):
         self._state_label = label
         return state
 
-    def execute(self, parent_ud: Any = None) -> Any:
-        ctx = self._report_start(parent_ud)
-        try:
-            return self._execute(parent_ud)
-        except BaseException as exc:
-            self._is_running = False
-            self._report_error(self._state_label, exc)
-            raise
-        finally:
-            introspection.leave(ctx)
+    def _on_failure(self) -> Any:
+        self._is_running = False
+        return self._state_label
 
     def _execute(self, parent_ud: Any) -> Any:
         self._is_running = True
@@ -118,13 +113,6 @@ class Iterator(Container):
 
     def get_children(self) -> dict:
         return {self._state_label: self._state} if self._state is not None else {}
-
-    def __getitem__(self, key: str) -> State:
-        if key != self._state_label:
-            log.logerr("Attempting to get state '%s' from Iterator container. The only available state is '%s'."
-                       % (key, self._state_label))
-            raise KeyError()
-        return self._state
 
     def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
         """Fixed against SMACH (a TypeError for several states): takes the first, merges the userdata."""

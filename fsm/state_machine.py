@@ -8,10 +8,12 @@ from . import introspection, log
 from .container import Container
 from .exceptions import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
 from .state import State
-from .user_data import Remapper, UserData
+from .user_data import Remapper
 
 
 class StateMachine(Container):
+    _kind_name = "StateMachine"
+
     def __init__(self, outcomes: Any, input_keys: list[str] = [], output_keys: list[str] = []) -> None:
         Container.__init__(self, outcomes, input_keys, output_keys)
         self._state_transitioning_lock = threading.Lock()
@@ -234,13 +236,6 @@ class StateMachine(Container):
     # Introspection.
     def get_children(self) -> dict:
         return self._states
-
-    def __getitem__(self, key: str) -> State:
-        if key not in self._states:
-            log.logerr("Attempting to get state '%s' from StateMachine container. The only available states are: %s"
-                       % (key, str(list(self._states.keys()))))
-            raise KeyError()
-        return self._states[key]
 
     def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
         log.logdebug("Setting initial states to " + str(initial_states))

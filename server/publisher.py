@@ -18,7 +18,6 @@ import collections
 import threading
 import time
 import urllib.parse
-from typing import Any
 
 from fsm.encoding import dumps
 from fsm.status import Status

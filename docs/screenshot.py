@@ -1,0 +1,47 @@
+"""Make docs/demo.png, the README's picture: the demo page mid-episode (graph beside the arm).
+
+    .venv/bin/python docs/screenshot.py
+
+Runs `fsmscope demo` as a real process and drives Debian's Chromium with Playwright, the
+same tooling as the browser tests (tests/browser_support.py).
+"""
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+from browser_support import DemoProcess, launch_chromium  # noqa: E402
+from playwright.sync_api import sync_playwright  # noqa: E402
+
+OUT = ROOT / "docs" / "demo.png"
+# Mid-episode: the arm carries the cube.
+WANTED = "s:/SM_ROOT/TASK/PLACE/TRANSPORT"
+
+
+def main() -> int:
+    with tempfile.TemporaryDirectory() as tmp:
+        demo = DemoProcess(Path(tmp) / "demo.jsonl")
+        try:
+            with sync_playwright() as pw:
+                browser = launch_chromium(pw)
+                page = browser.new_page(viewport={"width": 1600, "height": 900})
+                page.goto(demo.url)
+                page.wait_for_selector("#graph svg")
+                page.wait_for_selector("#scene-pane:not([hidden]) iframe")
+                page.frame_locator("#scene-pane iframe").locator("canvas").first.wait_for(state="visible")
+                page.wait_for_selector('[id="%s"].active' % WANTED, timeout=60000)
+                time.sleep(0.6)  # let the 3D view draw the arm where the graph says it is
+                page.screenshot(path=str(OUT))
+                browser.close()
+        finally:
+            demo.stop()
+    print("wrote", OUT)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -5,11 +5,13 @@ buffer, waking the event loop with ``call_soon_threadsafe`` when no wake-up is p
 Everything else (Status updates, the ring, fan-out to clients) happens on the loop, so the
 loop is the only thread that touches a machine's Status, ring and clients.
 
-Per client a bounded queue of encoded events; a client that falls behind has its queue
-dropped and is sent one ``missed`` marker and a fresh snapshot instead (coalesced state).
-A sender blocked for ``send_timeout`` seconds, or a queue that stays full that long, gets
-the client evicted: its sender is cancelled and its socket aborted (a clean close would wait
-for the unsent data of a stalled peer).
+Every event is encoded once, into the machine's ring of recent events; a client is a cursor into
+that ring, so the per-event work on the loop does not depend on how many clients there are, and
+a client whose sender is blocked (a stalled browser) costs nothing per event. A client more than
+``CLIENT_QUEUE`` events behind, or behind what the ring keeps, is sent one ``missed`` marker and
+a fresh snapshot instead (coalesced state; the snapshot frame is built once per state and shared).
+A sender blocked for ``send_timeout`` seconds gets the client evicted: its sender is cancelled
+and its socket aborted (a clean close would wait for the unsent data of a stalled peer).
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ from fsm.encoding import dumps
 from fsm.status import Status
 
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
-CLIENT_QUEUE = 4000        # events queued per client before it is sent a snapshot instead
+CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
 MAX_BATCH = 1000           # events per frame at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
 
@@ -45,57 +47,52 @@ def count_states(node: dict | None) -> int:
 
 
 class Client:
-    """One websocket subscriber of one machine: its bounded queue and its sender's bookkeeping."""
+    """One websocket subscriber of one machine: a cursor into the machine's ring, and its sender's bookkeeping.
 
-    __slots__ = ("entry", "pending", "need_snapshot", "missed", "wake", "overflow_since", "send_started",
-                 "task", "abort", "evicted", "address")
+    A client holds no events of its own: every event is encoded once into the machine's ring and each
+    sender reads from there at its own cursor. So an event costs the loop the same with any number of
+    clients, and nothing at all per client that is not idle (a stalled one is blocked in its send).
+    """
+
+    __slots__ = ("entry", "cursor", "need_snapshot", "wake", "send_started", "task", "abort", "evicted",
+                 "address")
 
     def __init__(self, entry: MachineEntry, abort: Callable[[], None] | None, address: str) -> None:
         self.entry = entry
-        self.pending: collections.deque[bytes] = collections.deque()
+        self.cursor = 0  # the seq of the next event to send
         self.need_snapshot = False
-        self.missed = 0
         self.wake = asyncio.Event()
-        self.overflow_since: float | None = None
         self.send_started: float | None = None
         self.task: asyncio.Task | None = None
         self.abort = abort
         self.evicted = False
         self.address = address
 
-    def push(self, encoded: bytes) -> None:
-        if self.need_snapshot:
-            self.missed += 1
-            return
-        if len(self.pending) >= CLIENT_QUEUE:
-            self.missed += len(self.pending) + 1
-            self.pending.clear()
-            self.need_snapshot = True
-            self.overflow_since = time.monotonic()
-            return
-        self.pending.append(encoded)
-
     def take_frames(self) -> list[str]:
-        """What to send next (called on the loop; the snapshot is taken here, atomically)."""
-        if self.need_snapshot:
-            frames = []
-            if self.missed:
-                frames.append('{"type":"missed","count":%d}' % self.missed)
-            frames.append(self.entry.snapshot_frame())
-            self.need_snapshot = False
-            self.missed = 0
-            self.overflow_since = None
-            self.pending.clear()
-            return frames
-        if not self.pending:
-            return []
-        pending = self.pending
-        if len(pending) == 1:
-            batch = [pending.popleft()]
-        else:
-            n = min(len(pending), MAX_BATCH)
-            batch = [pending.popleft() for _ in range(n)]
-        return [(_FRAME_HEAD + b",".join(batch) + _FRAME_TAIL).decode()]
+        """What to send next (called on the loop): events from the ring, or missed + a snapshot."""
+        entry = self.entry
+        if not self.need_snapshot:
+            last = entry.ring_last()
+            if self.cursor > last:
+                return []
+            batch = None
+            if last - self.cursor < CLIENT_QUEUE:
+                batch = entry.encoded_from(self.cursor, MAX_BATCH)
+            if batch:
+                self.cursor += len(batch)
+                if len(batch) == 1:
+                    return [(_FRAME_HEAD + batch[0] + _FRAME_TAIL).decode()]
+                return [(_FRAME_HEAD + b",".join(batch) + _FRAME_TAIL).decode()]
+            # Too far behind, or what it needs is no longer kept: coalesce into a snapshot.
+        seq, frame = entry.snapshot()
+        frames = []
+        missed = seq - self.cursor + 1 if self.cursor else 0
+        if missed > 0:
+            frames.append('{"type":"missed","count":%d}' % missed)
+        frames.append(frame)
+        self.need_snapshot = False
+        self.cursor = seq + 1
+        return frames
 
 
 class MachineEntry:
@@ -108,11 +105,13 @@ class MachineEntry:
         self.status = Status(name)
         self.ring: collections.deque[tuple[int, bytes]] = collections.deque(maxlen=RING_SIZE)
         self.clients: set[Client] = set()
+        self.idle: set[Client] = set()  # clients whose sender waits for the next event
         self.handle: Any = None  # server.control.MachineHandle for local machines
         self.reporter: introspection.Reporter | None = None
         self._structure_id: int | None = None
         self._structure_hash = ""
         self._n_states = 0
+        self._snapshot: tuple[int, int, str] | None = None  # (id(status), last_seq, frame)
 
     # Read on the loop.
     def structure_info(self) -> tuple[str, int]:
@@ -126,47 +125,71 @@ class MachineEntry:
     def snapshot_dict(self) -> dict:
         return {"type": "snapshot", "status": self.status.to_dict(), "last_seq": self.status.last_seq}
 
-    def snapshot_frame(self) -> str:
-        return dumps(self.snapshot_dict()).decode()
+    def snapshot(self) -> tuple[int, str]:
+        """(last_seq, the snapshot frame): built once per state, shared by every client that needs it."""
+        status = self.status
+        cached = self._snapshot
+        if cached is None or cached[0] != id(status) or cached[1] != status.last_seq:
+            cached = self._snapshot = (id(status), status.last_seq, dumps(self.snapshot_dict()).decode())
+        return cached[1], cached[2]
 
     def running(self) -> bool:
         if self.handle is not None:
             return self.handle.is_running()
         return self.status.running
 
+    def ring_last(self) -> int:
+        """The seq of the newest event in the ring (the status's when the ring is empty)."""
+        return self.ring[-1][0] if self.ring else self.status.last_seq
+
+    def encoded_from(self, seq: int, limit: int) -> list[bytes] | None:
+        """Up to ``limit`` encoded events from ``seq`` on; None when ``seq`` is no longer kept."""
+        ring = self.ring
+        if not ring:
+            return None
+        first = ring[0][0]
+        if seq < first:
+            return None
+        idx = seq - first
+        if idx >= len(ring) or ring[idx][0] != seq:  # seqs with a gap: find it the slow way
+            for idx, (s, _) in enumerate(ring):
+                if s >= seq:
+                    break
+            else:
+                return []
+        stop = min(len(ring), idx + limit)
+        return [ring[i][1] for i in range(idx, stop)]
+
     def events_after(self, since: int) -> list[bytes] | None:
         """Encoded events with seq > since, or None when some of them are no longer kept."""
         last = self.status.last_seq
         if since == last:
             return []
-        if since > last or not self.ring:
+        if since > last or not self.ring or since + 1 < self.ring[0][0]:
             return None
-        first = self.ring[0][0]
-        if since + 1 < first:
-            return None
-        idx = since + 1 - first
-        ring = self.ring
-        if idx < len(ring) and ring[idx][0] == since + 1:
-            return [ring[i][1] for i in range(idx, len(ring))]
-        return [enc for seq, enc in ring if seq > since]
+        return self.encoded_from(since + 1, RING_SIZE)
 
     def reset(self, status: Status) -> None:
         """A new epoch (an ingesting process restarted, or sent a snapshot): clients start over."""
         self.status = status
         self.ring.clear()
         for client in self.clients:
-            client.pending.clear()
             client.need_snapshot = True
-            client.wake.set()
+        self.wake_idle()
+
+    def wake_idle(self) -> None:
+        idle = self.idle
+        if idle:
+            for client in idle:
+                client.wake.set()
+            idle.clear()
 
     def apply(self, event: dict) -> None:
-        """On the loop: update the Status, keep the event, queue it for every client."""
+        """On the loop: update the Status, keep the event (encoded once, for every client), wake idle senders."""
         self.status.apply(event)
-        encoded = dumps(event)
-        self.ring.append((event["seq"], encoded))
-        for client in self.clients:
-            client.push(encoded)
-            client.wake.set()
+        self.ring.append((event["seq"], dumps(event)))
+        if self.idle:
+            self.wake_idle()
 
 
 class Hub:
@@ -279,9 +302,17 @@ class Hub:
     def _drain(self) -> None:
         self._scheduled = False
         incoming = self._incoming
+        touched = set()
+        last = None
         while incoming:
             entry, event = incoming.popleft()
-            entry.apply(event)
+            entry.status.apply(event)
+            entry.ring.append((event["seq"], dumps(event)))
+            if entry is not last:
+                touched.add(entry)
+                last = entry
+        for entry in touched:  # wake idle senders once per drain, not once per event
+            entry.wake_idle()
 
     def flush(self) -> None:
         """On the loop: apply whatever machine threads handed over (before reading a Status)."""
@@ -319,13 +350,14 @@ class Hub:
         if after is None:
             client.need_snapshot = True
         else:
-            client.pending.extend(after)
+            client.cursor = since + 1
         entry.clients.add(client)
         client.wake.set()
         return client
 
     def unsubscribe(self, client: Client) -> None:
         client.entry.clients.discard(client)
+        client.entry.idle.discard(client)
 
     def evict(self, client: Client) -> None:
         if client.evicted:
@@ -347,6 +379,7 @@ class Hub:
                 frames = client.take_frames()
                 if not frames:
                     client.wake.clear()
+                    client.entry.idle.add(client)
                     await client.wake.wait()
                     continue
                 for frame in frames:
@@ -363,7 +396,5 @@ class Hub:
             for entry in self.machines():
                 for client in list(entry.clients):
                     started = client.send_started
-                    full = client.overflow_since
-                    if (started is not None and now - started > SEND_TIMEOUT) or \
-                            (full is not None and now - full > SEND_TIMEOUT):
+                    if started is not None and now - started > SEND_TIMEOUT:
                         self.evict(client)

@@ -1,6 +1,7 @@
 """Helpers for the server tests: small machines, an authenticated HTTP client, websocket frames."""
 
 import json
+import socket
 import threading
 import time
 
@@ -112,3 +113,33 @@ def wait_for(predicate, timeout=5.0):
             return
         time.sleep(0.005)
     raise AssertionError("condition not met in %.1f s" % timeout)
+
+
+def stalled_stream(srv, name):
+    """A websocket to ``name``'s stream that completes the handshake and then never reads (a stalled browser)."""
+    raw = socket.create_connection(("127.0.0.1", srv.port))
+    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+    raw.sendall(("GET /api/machines/%s/stream?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
+                 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                 "Sec-WebSocket-Version: 13\r\n\r\n" % (name, srv.token, srv.port)).encode())
+    assert b"101" in raw.recv(200)
+    return raw
+
+
+def blob_loop(n, size=2000):
+    """A one-state loop that runs ``n`` times, writing ``size`` bytes of userdata each time (big frames)."""
+    count = {"n": 0}
+
+    def step(ud):
+        count["n"] += 1
+        ud.blob = "x" * size
+        if count["n"] >= n:
+            count["n"] = 0
+            return "stop"
+        return "again"
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(step, outcomes=["again", "stop"], output_keys=["blob"]),
+                             {"again": "A", "stop": "done"})
+    return sm

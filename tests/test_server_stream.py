@@ -1,6 +1,5 @@
 """The websocket stream and ingest against a real uvicorn, with the `websockets` client."""
 
-import socket
 import threading
 import time
 
@@ -11,8 +10,8 @@ from websockets.sync.client import connect
 
 from server import hub as hub_module
 from server.publisher import Publisher
-from server_support import (client, events_of, frames, nested_machine, stream, two_state_machine, wait_for,
-                            waiting_machine)
+from server_support import (blob_loop, client, events_of, frames, nested_machine, stalled_stream, stream,
+                            two_state_machine, wait_for, waiting_machine)
 
 
 def has_terminate(got):
@@ -84,7 +83,7 @@ def test_a_client_that_falls_behind_gets_missed_then_a_snapshot(live_server, mon
         [client] = list(entry.clients)
         client.wake.set = lambda: None  # the sender sleeps through the run: its queue overflows
         sm.execute()
-        wait_for(lambda: client.need_snapshot and not live_server.hub._incoming)
+        wait_for(lambda: entry.ring_last() == entry.reporter.last_seq)
         asyncio_set(live_server, client)
         got = frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
     assert got[0]["type"] == "missed" and got[0]["count"] > 5
@@ -99,24 +98,9 @@ def asyncio_set(srv, client):
 def test_a_stalled_client_is_dropped_and_the_machine_does_not_wait(live_server, monkeypatch):
     monkeypatch.setattr(hub_module, "SEND_TIMEOUT", 0.5)
     monkeypatch.setattr(hub_module, "CLIENT_QUEUE", 100000)
-    counter = {"n": 0}
-
-    def loop(ud):
-        counter["n"] += 1
-        ud.blob = "x" * 2000
-        return "again" if counter["n"] < 20000 else "stop"
-
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        fsm.StateMachine.add("A", fsm.CBState(loop, outcomes=["again", "stop"], output_keys=["blob"]),
-                             {"again": "A", "stop": "done"})
+    sm = blob_loop(20000)
     entry = live_server.hub.add_local(sm, name="loop")
-    raw = socket.create_connection(("127.0.0.1", live_server.port))
-    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    raw.sendall(("GET /api/machines/loop/stream?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
-                 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-                 "Sec-WebSocket-Version: 13\r\n\r\n" % (live_server.token, live_server.port)).encode())
-    assert b"101" in raw.recv(200)  # then never read again
+    raw = stalled_stream(live_server, "loop")  # never read again
     wait_for(lambda: len(entry.clients) == 1)
     started = time.monotonic()
     assert sm.execute() == "done"

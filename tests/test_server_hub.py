@@ -1,0 +1,62 @@
+"""The hub's fan-out costs, against a real uvicorn: one encode per event, nothing per event for a stalled client."""
+
+import asyncio
+
+from server import hub as hub_module
+from server_support import blob_loop, events_of, frames, stalled_stream, stream, two_state_machine, wait_for
+
+
+def has_terminate(got):
+    return any(e["kind"] == "terminate" and e["path"] == "/SM_ROOT" for e in events_of(got))
+
+
+def test_each_event_is_encoded_once_for_all_clients(live_server, monkeypatch):
+    encoded = []
+    real = hub_module.dumps
+
+    def counting(obj):
+        if "seq" in obj and "kind" in obj:
+            encoded.append(obj["seq"])
+        return real(obj)
+
+    monkeypatch.setattr(hub_module, "dumps", counting)
+    sm = two_state_machine()
+    entry = live_server.hub.add_local(sm, name="two")
+    sockets = [stream(live_server, "two") for _ in range(3)]
+    for ws in sockets:
+        frames(ws, lambda got: len(got) == 1)  # the snapshot
+    sm.execute()
+    for ws in sockets:
+        frames(ws, has_terminate)
+        ws.close()
+    assert sorted(encoded) == list(range(1, entry.reporter.last_seq + 1))
+
+
+class CountingEvent(asyncio.Event):
+    def __init__(self):
+        super().__init__()
+        self.sets = 0
+
+    def set(self):
+        self.sets += 1
+        super().set()
+
+
+def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
+    monkeypatch.setattr(hub_module, "SEND_TIMEOUT", 60)
+    sm = blob_loop(3000)
+    entry = live_server.hub.add_local(sm, name="loop")
+    raw = stalled_stream(live_server, "loop")
+    try:
+        wait_for(lambda: len(entry.clients) == 1)
+        [client] = list(entry.clients)
+        while client.send_started is None:  # fill the socket buffers until its send blocks
+            sm.execute()
+        counting = client.wake = CountingEvent()
+        for _ in range(5):
+            sm.execute()  # 5 x 3,000 more events
+        wait_for(lambda: entry.ring_last() == entry.reporter.last_seq)
+        assert client.send_started is not None and counting.sets == 0
+        assert client not in entry.idle
+    finally:
+        raw.close()

@@ -151,7 +151,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     @app.get("/api/machines/{name}/status", response_model=models.MachineStatus, dependencies=auth,
              responses=ERRORS, tags=["machines"])
     async def status(name: Annotated[str, NAME]) -> Any:
-        data = machine(name).status.to_dict()
+        data = machine(name).status_dict()
         data.pop("structure", None)
         return data
 

@@ -1,9 +1,13 @@
 """The Hub: one per server. Machines by name, each with its Status, a ring of recent events and its clients.
 
-Threads: a machine's observer runs in the machine's thread and only appends the event to a
-buffer, waking the event loop with ``call_soon_threadsafe`` when no wake-up is pending.
-Everything else (Status updates, the ring, fan-out to clients) happens on the loop, so the
-loop is the only thread that touches a machine's Status, ring and clients.
+Threads: a machine's observer runs in the machine's thread. It applies the event to the
+entry's Status there (under the entry's lock, so the Status is never behind the machine and
+never depends on the loop keeping up), encodes it, and appends the encoded event to the entry's
+bounded hand-off buffer, waking the event loop with ``call_soon_threadsafe`` when no wake-up
+is pending. When the loop does not drain fast enough and the buffer holds ``HANDOFF_LIMIT``
+events, the buffered events are dropped (counted): the ring then has a gap, and every client
+behind it is sent ``missed`` and a snapshot, taken from the Status, which is always complete.
+The loop owns the ring and the clients; it reads the Status under the entry's lock.
 
 Every event is encoded once, into the machine's ring of recent events; a client is a cursor into
 that ring, so the per-event work on the loop does not depend on how many clients there are, and
@@ -31,6 +35,7 @@ RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
 MAX_BATCH = 1000           # events per frame at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
+HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
 
 _FRAME_HEAD = b'{"type":"events","events":['
 _FRAME_TAIL = b"]}"
@@ -72,7 +77,7 @@ class Client:
         """What to send next (called on the loop): events from the ring, or missed + a snapshot."""
         entry = self.entry
         if not self.need_snapshot:
-            last = entry.ring_last()
+            last = entry.loop_seq
             if self.cursor > last:
                 return []
             batch = None
@@ -103,7 +108,12 @@ class MachineEntry:
         self.name = name
         self.source = source
         self.status = Status(name)
+        self.lock = threading.Lock()  # guards the Status (applied in machine threads) and the hand-off
+        self.handoff: collections.deque[tuple[int, bytes]] = collections.deque()  # machine thread -> loop
+        self.dropped = 0  # events dropped from the hand-off since the loop last drained it
+        self.queued = False  # the entry waits in the hub's ready queue
         self.ring: collections.deque[tuple[int, bytes]] = collections.deque(maxlen=RING_SIZE)
+        self.loop_seq = 0  # the seq of the newest event the loop has taken (the ring's end, gaps or not)
         self.clients: set[Client] = set()
         self.idle: set[Client] = set()  # clients whose sender waits for the next event
         self.handle: Any = None  # server.control.MachineHandle for local machines
@@ -122,29 +132,38 @@ class MachineEntry:
             self._n_states = count_states(root)
         return self._structure_hash, self._n_states
 
+    def status_dict(self) -> dict:
+        """``Status.to_dict()``, consistent (machine threads apply events to it concurrently)."""
+        with self.lock:
+            return self.status.to_dict()
+
     def snapshot_dict(self) -> dict:
-        return {"type": "snapshot", "status": self.status.to_dict(), "last_seq": self.status.last_seq}
+        status = self.status_dict()
+        return {"type": "snapshot", "status": status, "last_seq": status["last_seq"]}
 
     def snapshot(self) -> tuple[int, str]:
         """(last_seq, the snapshot frame): built once per state, shared by every client that needs it."""
-        status = self.status
-        cached = self._snapshot
-        if cached is None or cached[0] != id(status) or cached[1] != status.last_seq:
-            cached = self._snapshot = (id(status), status.last_seq, dumps(self.snapshot_dict()).decode())
-        return cached[1], cached[2]
+        with self.lock:
+            status = self.status
+            cached = self._snapshot
+            if cached is not None and cached[0] == id(status) and cached[1] == status.last_seq:
+                return cached[1], cached[2]
+            data = status.to_dict()
+            key = (id(status), status.last_seq)
+        frame = dumps({"type": "snapshot", "status": data, "last_seq": key[1]}).decode()
+        self._snapshot = (key[0], key[1], frame)
+        return key[1], frame
 
     def running(self) -> bool:
         if self.handle is not None:
             return self.handle.is_running()
         return self.status.running
 
-    def ring_last(self) -> int:
-        """The seq of the newest event in the ring (the status's when the ring is empty)."""
-        return self.ring[-1][0] if self.ring else self.status.last_seq
-
     def encoded_from(self, seq: int, limit: int) -> list[bytes] | None:
         """Up to ``limit`` encoded events from ``seq`` on; None when ``seq`` is no longer kept."""
         ring = self.ring
+        if seq > self.loop_seq:
+            return []
         if not ring:
             return None
         first = ring[0][0]
@@ -162,17 +181,16 @@ class MachineEntry:
 
     def events_after(self, since: int) -> list[bytes] | None:
         """Encoded events with seq > since, or None when some of them are no longer kept."""
-        last = self.status.last_seq
-        if since == last:
-            return []
-        if since > last or not self.ring or since + 1 < self.ring[0][0]:
+        if since > self.status.last_seq:
             return None
         return self.encoded_from(since + 1, RING_SIZE)
 
     def reset(self, status: Status) -> None:
         """A new epoch (an ingesting process restarted, or sent a snapshot): clients start over."""
-        self.status = status
+        with self.lock:
+            self.status = status
         self.ring.clear()
+        self.loop_seq = status.last_seq
         for client in self.clients:
             client.need_snapshot = True
         self.wake_idle()
@@ -185,9 +203,41 @@ class MachineEntry:
             idle.clear()
 
     def apply(self, event: dict) -> None:
-        """On the loop: update the Status, keep the event (encoded once, for every client), wake idle senders."""
-        self.status.apply(event)
+        """On the loop (ingest): update the Status, keep the event (encoded once, for every client), wake idle senders."""
+        with self.lock:
+            self.status.apply(event)
         self.ring.append((event["seq"], dumps(event)))
+        self.loop_seq = event["seq"]
+        if self.idle:
+            self.wake_idle()
+
+    def observe(self, event: dict) -> bool:
+        """In the machine's thread: apply, encode, hand over; True when the loop must be told."""
+        encoded = dumps(event)
+        with self.lock:
+            self.status.apply(event)
+            handoff = self.handoff
+            if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
+                self.dropped += len(handoff)
+                handoff.clear()
+            handoff.append((event["seq"], encoded))
+            if self.queued:
+                return False
+            self.queued = True
+            return True
+
+    def take_handoff(self) -> None:
+        """On the loop: move what the machine threads handed over into the ring; wake idle senders."""
+        with self.lock:
+            items, self.handoff = self.handoff, collections.deque()
+            dropped, self.dropped = self.dropped, 0
+            self.queued = False
+        if not items:
+            return
+        if dropped:  # a gap: clients whose cursor falls in it are sent missed + a snapshot
+            self.ring.clear()
+        self.ring.extend(items)
+        self.loop_seq = items[-1][0]
         if self.idle:
             self.wake_idle()
 
@@ -199,7 +249,7 @@ class Hub:
         self.loop: asyncio.AbstractEventLoop | None = None
         self._machines: dict[str, MachineEntry] = {}
         self._lock = threading.Lock()
-        self._incoming: collections.deque[tuple[MachineEntry, dict]] = collections.deque()
+        self._incoming: collections.deque[MachineEntry] = collections.deque()  # entries with a hand-off to take
         self._scheduled = False
         self._watchdog: asyncio.Task | None = None
         self._hook: Callable | None = None
@@ -254,13 +304,16 @@ class Hub:
         entry.handle = MachineHandle(machine, rep, can_start)
         entry.status.apply({"seq": rep.last_seq, "kind": "structure", "path": rep.root_path, "run": rep.run,
                             "root": rep.structure()})
+        entry.loop_seq = rep.last_seq
         incoming = self._incoming
         schedule = self._schedule
+        observe = entry.observe
 
         def observer(event: dict) -> None:
-            incoming.append((entry, event))
-            if not self._scheduled:
-                schedule()
+            if observe(event):
+                incoming.append(entry)
+                if not self._scheduled:
+                    schedule()
 
         entry.handle.observer = observer
         with self._lock:
@@ -302,20 +355,11 @@ class Hub:
     def _drain(self) -> None:
         self._scheduled = False
         incoming = self._incoming
-        touched = set()
-        last = None
         while incoming:
-            entry, event = incoming.popleft()
-            entry.status.apply(event)
-            entry.ring.append((event["seq"], dumps(event)))
-            if entry is not last:
-                touched.add(entry)
-                last = entry
-        for entry in touched:  # wake idle senders once per drain, not once per event
-            entry.wake_idle()
+            incoming.popleft().take_handoff()
 
     def flush(self) -> None:
-        """On the loop: apply whatever machine threads handed over (before reading a Status)."""
+        """On the loop: take whatever machine threads handed over into the rings (before reading them)."""
         if self._incoming:
             self._drain()
 

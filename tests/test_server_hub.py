@@ -1,7 +1,12 @@
 """The hub's fan-out costs, against a real uvicorn: one encode per event, nothing per event for a stalled client."""
 
 import asyncio
+import threading
 
+import fsm
+from fsm.status import Status
+
+from recording_support import two_state_loop
 from server import hub as hub_module
 from server_support import blob_loop, events_of, frames, stalled_stream, stream, two_state_machine, wait_for
 
@@ -55,8 +60,39 @@ def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
         counting = client.wake = CountingEvent()
         for _ in range(5):
             sm.execute()  # 5 x 3,000 more events
-        wait_for(lambda: entry.ring_last() == entry.reporter.last_seq)
+        wait_for(lambda: entry.loop_seq == entry.reporter.last_seq)
         assert client.send_started is not None and counting.sets == 0
         assert client not in entry.idle
     finally:
         raw.close()
+
+
+def test_a_blocked_loop_bounds_the_handoff_and_clients_end_with_the_true_status(live_server):
+    quiet = lambda msg: None  # noqa: E731
+    fsm.set_loggers(quiet, quiet, quiet, quiet)
+    sm = two_state_loop(100_000)  # 200k transitions
+    entry = live_server.hub.add_local(sm, name="flood")
+    truth = Status("flood")
+    fsm.attach(sm, truth.apply)
+    with stream(live_server, "flood") as ws:
+        frames(ws, lambda got: len(got) == 1)  # the snapshot
+        blocked, release = threading.Event(), threading.Event()
+        live_server.hub.loop.call_soon_threadsafe(lambda: (blocked.set(), release.wait(60)))
+        assert blocked.wait(5)
+        longest = [0]
+
+        def watch(event):
+            longest[0] = max(longest[0], len(entry.handoff))
+        fsm.attach(sm, watch)
+        try:
+            assert sm.execute() == "done"
+            assert entry.reporter.last_seq > 200_000
+            assert longest[0] <= hub_module.HANDOFF_LIMIT  # memory bounded while nobody drains
+            assert entry.status_dict()["outcome"] == "done"  # the hub's Status did not wait for the loop
+        finally:
+            release.set()
+        got = frames(ws, lambda got: got and got[-1]["type"] == "snapshot" and
+                     got[-1]["last_seq"] == entry.reporter.last_seq, timeout=10)
+    assert got[-2]["type"] == "missed" and got[-2]["count"] > 0
+    expected = truth.to_dict()
+    assert got[-1]["status"] == expected

@@ -83,7 +83,7 @@ def test_a_client_that_falls_behind_gets_missed_then_a_snapshot(live_server, mon
         [client] = list(entry.clients)
         client.wake.set = lambda: None  # the sender sleeps through the run: its queue overflows
         sm.execute()
-        wait_for(lambda: entry.ring_last() == entry.reporter.last_seq)
+        wait_for(lambda: entry.loop_seq == entry.reporter.last_seq)
         asyncio_set(live_server, client)
         got = frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
     assert got[0]["type"] == "missed" and got[0]["count"] > 5

@@ -112,12 +112,16 @@ class Bus:
 
     # Topics
 
-    def publish(self, topic: str, msg: Any) -> None:
-        """Deliver ``msg`` to every subscriber of ``topic``; a raising callback is logged and skipped."""
+    def publish(self, topic: str, msg: Any) -> int:
+        """Deliver ``msg`` to every subscriber of ``topic``; returns how many subscribers it reached.
+
+        A raising callback is logged and skipped (and still counted: the message reached it).
+        """
         with self._lock:
             subscribers = list(self._subscribers.get(topic, ()))
         for sub in subscribers:
             call_logged("subscriber callback on topic '%s'" % topic, sub.callback, msg)
+        return len(subscribers)
 
     def subscribe(self, topic: str, callback: Callable[[Any], Any]) -> Subscription:
         sub = Subscription(self, topic, callback)

@@ -176,7 +176,4 @@ def publish(topic: str, message: Any) -> int:
     """Publish on the in-process bus; returns how many subscribers it reached."""
     from fsm.bus import default_bus
 
-    subscribers = getattr(default_bus, "_subscribers", {}).get(topic, ())
-    count = len(subscribers)
-    result = default_bus.publish(topic, message)
-    return result if isinstance(result, int) and not isinstance(result, bool) else count
+    return default_bus.publish(topic, message)

@@ -18,9 +18,16 @@ def test_publish_reaches_every_subscriber_of_the_topic_only(bus):
     assert (got_a, got_b, got_other) == ([1], [1], [])
 
 
-def test_publish_without_subscribers_does_nothing(bus):
-    bus.publish("nobody", {"x": 1})
+def test_publish_without_subscribers_does_nothing_and_returns_0(bus):
+    assert bus.publish("nobody", {"x": 1}) == 0
     assert bus.topics() == []
+
+
+def test_publish_returns_the_number_of_subscribers_reached(bus, logs):
+    bus.subscribe("t", lambda msg: None)
+    bus.subscribe("t", lambda msg: 1 / 0)  # reached, though it raised
+    bus.subscribe("other", lambda msg: None)
+    assert bus.publish("t", None) == 2
 
 
 def test_raising_subscriber_is_logged_and_does_not_stop_the_others(bus, logs):

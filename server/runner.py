@@ -5,6 +5,10 @@ top-level machine the first time it starts, naming it after the script (``foo_ba
 then ``foo_bar#2`` for a second machine). Whoever serves a dashboard registers
 ``on_machine`` callbacks to attach its own observers to the same machines (they run in
 the machine's thread, before its first event).
+
+With ``keep_open`` the log stays open after the script ends (``fsmscope run`` keeps serving the
+dashboard, where POST .../start re-runs a machine: those runs are recorded too) until
+``close()``, which writes what is left, fsyncs and says what was recorded.
 """
 
 from __future__ import annotations
@@ -47,11 +51,13 @@ class Runner:
     on_machine: list[MachineCallback] = field(default_factory=list)
     machines: list[Machine] = field(default_factory=list)
     recorder: Recorder | None = None
+    keep_open: bool = False  # leave the log open when the script ends, until close()
 
     def __post_init__(self) -> None:
         self.stem = os.path.splitext(os.path.basename(self.script))[0]
         self.record_path = self.record or default_record_path(self.script)
         self._lock = threading.Lock()
+        self._restore_sigterm: Callable[[], None] = lambda: None
 
     def _hook(self, container: Any) -> None:
         with self._lock:
@@ -83,7 +89,7 @@ class Runner:
             sys.path[0] = os.path.dirname(script)
         else:
             sys.path.insert(0, os.path.dirname(script))
-        restore_sigterm = _sigterm_as_exit()
+        self._restore_sigterm = _sigterm_as_exit()
         fsm.add_global_hook(self._hook)
         code = 0
         try:
@@ -97,15 +103,22 @@ class Runner:
             code = 1
         finally:
             fsm.remove_global_hook(self._hook)
-            restore_sigterm()
             sys.argv = saved_argv
             if saved_path0 is not None and sys.path:
                 sys.path[0] = saved_path0
-            self.recorder.close()
-            names = ", ".join(m.name for m in self.machines) or "no machine"
-            sys.stderr.write("fsmscope: recorded %d events (%s) to %s\n"
-                             % (self.recorder.events, names, self.record_path))
+            if not self.keep_open:
+                self.close()
         return code
+
+    def close(self) -> None:
+        """Close the log (write, fsync) and say what it holds; idempotent."""
+        recorder = self.recorder
+        if recorder is None or recorder.closed:
+            return
+        recorder.close()
+        self._restore_sigterm()  # SIGTERM closed the log through SystemExit until now
+        names = ", ".join(m.name for m in self.machines) or "no machine"
+        sys.stderr.write("fsmscope: recorded %d events (%s) to %s\n" % (recorder.events, names, self.record_path))
 
 
 def _exit_code(code: Any) -> int:

@@ -57,6 +57,7 @@ def run_with_dashboard(args: argparse.Namespace, runner: Any) -> int:
         return 1
     hub = srv.hub
     runner.on_machine.append(lambda name, container: hub.add_local(container, name=name, can_start=True))
+    runner.keep_open = True  # runs started from the dashboard after the script ends are recorded too
     print("fsmscope: dashboard at %s" % srv.url, file=sys.stderr, flush=True)
     try:
         code = runner.run()
@@ -66,4 +67,5 @@ def run_with_dashboard(args: argparse.Namespace, runner: Any) -> int:
             wait_for_interrupt()
     finally:
         srv.stop()
+        runner.close()
     return code

@@ -2,10 +2,15 @@
 
 import json
 import os
+import queue
+import re
+import signal
 import subprocess
 import sys
+import threading
 import time
 
+import httpx
 import pytest
 from fsm.encoding import dumps
 
@@ -122,3 +127,43 @@ def test_replay_follow_tails_a_log_until_its_writer_closes_it(tmp_path):
         writer.wait(30)
     assert done.returncode == 0, done.stderr
     assert "machine nested_monitor: finished with outcome 'preempted'" in done.stdout
+
+
+def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(tmp_path):
+    log = tmp_path / "rerun.jsonl"
+    env = dict(os.environ, PYTHONPATH=ROOT)
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "run", os.path.join(EXAMPLES, "foo_bar.py"),
+                             "--record", str(log)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            text=True)
+    lines = queue.Queue()
+    threading.Thread(target=lambda: [lines.put(line) for line in proc.stderr], daemon=True).start()
+
+    def line_matching(pattern):
+        deadline = time.monotonic() + 30
+        while time.monotonic() < deadline:
+            found = re.search(pattern, lines.get(timeout=max(0.01, deadline - time.monotonic())))
+            if found:
+                return found
+        raise AssertionError("no line matching %r" % pattern)
+
+    try:
+        base, token = line_matching(r"dashboard at (http://[^/]+)/\?token=(\S+)").groups()
+        line_matching("the script ended")
+        http = httpx.Client(base_url=base, headers={"Authorization": "Bearer " + token}, timeout=10)
+        first_run = http.get("/api/machines/foo_bar/status").json()["run"]
+        assert http.post("/api/machines/foo_bar/start", json={}).status_code == 202
+        deadline = time.monotonic() + 10
+        while True:
+            status = http.get("/api/machines/foo_bar/status").json()
+            if status["run"] != first_run and not status["running"] and status["outcome"] == "end":
+                break
+            assert time.monotonic() < deadline
+            time.sleep(0.02)
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    summary = json.loads(cli("replay", log, "--json").stdout)
+    assert summary["machines"]["foo_bar"]["runs"] == 2 and summary["machines"]["foo_bar"]["outcome"] == "end"

@@ -7,7 +7,7 @@ worker thread, never on the event loop.
 from __future__ import annotations
 
 import threading
-from typing import Any
+from typing import Any, Callable
 
 from fsm import introspection
 
@@ -36,12 +36,20 @@ def find_node(root: dict | None, path: str) -> dict | None:
 
 
 class MachineHandle:
-    """Preempt, set the initial state of, and re-run one local machine."""
+    """Preempt, set the initial state of, and re-run one local machine.
 
-    def __init__(self, machine: Any, reporter: introspection.Reporter, can_start: bool) -> None:
+    A re-run executes the machine in a new thread of this handle, unless a ``starter`` is given:
+    then a start calls ``starter()`` instead (in the request's worker thread, never on the event
+    loop), for a host that runs the machine in its own loop (the sim demo: "next episode").
+    A starter should return promptly; one that raises answers 409 with its message.
+    """
+
+    def __init__(self, machine: Any, reporter: introspection.Reporter, can_start: bool,
+                 starter: Callable[[], Any] | None = None) -> None:
         self.machine = machine
         self.reporter = reporter
         self.can_start = can_start
+        self.starter = starter
         self.observer: Any = None
         self._lock = threading.Lock()
         self._thread: threading.Thread | None = None
@@ -155,6 +163,14 @@ class MachineHandle:
             for target, states, userdata in pending:
                 self._apply(target, states, userdata)
             seq = self.emit_control("start", client, "accepted")
+            if self.starter is not None:
+                try:
+                    self.starter()
+                except Exception as exc:
+                    message = "the starter failed: %s: %s" % (type(exc).__name__, exc)
+                    self.emit_control("start", client, message)
+                    raise ControlError(409, message) from exc
+                return seq
             thread = threading.Thread(target=self._run, name="fsmscope-run-%s" % self.reporter.machine, daemon=True)
             self._thread = thread
             thread.start()

@@ -287,8 +287,12 @@ class Hub:
             return "%s-%d" % (name, i)
 
     def add_local(self, machine: Any, name: str | None = None, path: str = introspection.DEFAULT_ROOT_PATH,
-                  can_start: bool = True) -> MachineEntry:
-        """Observe ``machine`` (any thread). A machine already observed keeps its reporter's name."""
+                  can_start: bool = True, starter: Callable[[], Any] | None = None) -> MachineEntry:
+        """Observe ``machine`` (any thread). A machine already observed keeps its reporter's name.
+
+        ``starter``: what POST .../start calls (in a worker thread) instead of executing the machine
+        in a new thread, for a host that runs the machine in its own loop (see control.MachineHandle).
+        """
         from .control import MachineHandle
 
         rep = introspection.reporter_of(machine)
@@ -301,7 +305,7 @@ class Hub:
                                        path)
         entry = MachineEntry(self, rep.machine, "local")
         entry.reporter = rep
-        entry.handle = MachineHandle(machine, rep, can_start)
+        entry.handle = MachineHandle(machine, rep, can_start, starter)
         entry.status.apply({"seq": rep.last_seq, "kind": "structure", "path": rep.root_path, "run": rep.run,
                             "root": rep.structure()})
         entry.loop_seq = rep.last_seq

@@ -106,13 +106,13 @@ class IntrospectionServer:
     """smach_ros.IntrospectionServer's call shape: ``(name, machine, path)``, then ``start()`` and ``stop()``."""
 
     def __init__(self, name: str, machine: Any, path: str = "/SM_ROOT", host: str = "127.0.0.1", port: int = 0,
-                 token: str | None = None, can_start: bool = True) -> None:
+                 token: str | None = None, can_start: bool = True, starter: Any = None) -> None:
         self.name = name
         self.machine = machine
         self.path = path
         self._server = ServerThread(host=host, port=port, token=token)
         self.hub = self._server.hub
-        self.entry = self.hub.add_local(machine, name=name, path=path, can_start=can_start)
+        self.entry = self.hub.add_local(machine, name=name, path=path, can_start=can_start, starter=starter)
         self._started = False
 
     @property

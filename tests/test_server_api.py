@@ -202,3 +202,21 @@ def test_graph_svg_draws_an_unexpanded_container_as_one_node(live_server):
 def test_graph_of_an_unknown_expand_path_is_404(live_server):
     live_server.hub.add_local(nested_machine(), name="n")
     assert client(live_server).get("/api/machines/n/graph.svg", params={"expand": "/X"}).status_code == 404
+
+
+def test_start_with_a_starter_calls_it_in_a_worker_thread_instead_of_running_the_machine(live_server):
+    calls = []
+    sm = two_state_machine()
+    entry = live_server.hub.add_local(sm, name="hosted", starter=lambda: calls.append(threading.get_ident()))
+    answer = client(live_server).post("/api/machines/hosted/start", json={})
+    assert answer.status_code == 202
+    assert len(calls) == 1 and calls[0] not in (live_server._thread.ident, threading.get_ident())
+    assert entry.handle._thread is None and entry.reporter.run is None  # the hub did not execute it
+
+
+def test_a_failing_starter_answers_409_with_its_message(live_server):
+    def starter():
+        raise RuntimeError("no episode")
+    live_server.hub.add_local(two_state_machine(), name="hosted", starter=starter)
+    answer = client(live_server).post("/api/machines/hosted/start", json={})
+    assert answer.status_code == 409 and "no episode" in answer.json()["detail"]

@@ -32,9 +32,16 @@ def main() -> int:
                 page.goto(demo.url)
                 page.wait_for_selector("#graph svg")
                 page.wait_for_selector("#scene-pane:not([hidden]) iframe")
-                page.frame_locator("#scene-pane iframe").locator("canvas").first.wait_for(state="visible")
+                scene = page.frame_locator("#scene-pane iframe")
+                scene.locator("canvas").first.wait_for(state="visible")
+                # viser warns that WebGL runs in software: true here (no GPU), not on a user's desk.
+                close = scene.locator(".mantine-Notification-closeButton")
+                try:
+                    close.first.click(timeout=5000)
+                except Exception:
+                    pass
                 page.wait_for_selector('[id="%s"].active' % WANTED, timeout=60000)
-                time.sleep(0.6)  # let the 3D view draw the arm where the graph says it is
+                time.sleep(0.3)  # let the 3D view draw the arm where the graph says it is
                 page.screenshot(path=str(OUT))
                 browser.close()
         finally:

@@ -189,7 +189,10 @@ function track(ev) {
   const path = ev.path;
   switch (ev.kind) {
     case "start":
-      if (path === app.status.root_path) app.finishedText = null;
+      if (path === app.status.root_path && app.finishedText) {
+        app.finishedText = null;
+        notice("", "info", true); // the previous run's outcome no longer describes the machine
+      }
       app.pendingChanges.set(path, new Set());
       app.changed.set(path, new Set());
       app.lastEdge.delete(path);
@@ -210,12 +213,7 @@ function track(ev) {
       app.changed.set(path, app.pendingChanges.get(path) || new Set());
       app.pendingChanges.set(path, new Set());
       const last = ev.last && ev.last.length === 1 ? ev.last[0] : null;
-      const node = app.nodes.get(path);
-      if (last && node && ev.outcome) {
-        const tr = (node.transitions || []).find((t) => t.from === last
-          && (t.to === ev.outcome || (t.to === null && t.outcome === ev.outcome)));
-        if (tr) app.lastEdge.set(path, `e:${path}:${last}:${tr.outcome}`);
-      }
+      if (last && ev.state_outcome) app.lastEdge.set(path, `e:${path}:${last}:${ev.state_outcome}`);
       if (path === app.status.root_path) {
         const outcome = ev.outcome === null ? "no outcome" + (ev.error ? ` (${ev.error})` : "") : `outcome '${ev.outcome}'`;
         app.finishedText = `${app.name} finished: ${outcome}`;

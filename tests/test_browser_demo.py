@@ -56,7 +56,7 @@ def test_demo_page_draws_the_arm_in_the_3d_view(page):
     orange = 0
     while time.monotonic() < deadline:
         shot = Image.open(io.BytesIO(page.locator("#scene-pane .scene").screenshot())).convert("RGB")
-        orange = sum(1 for pixel in shot.getdata() if is_arm_orange(*pixel))
+        orange = sum(1 for pixel in shot.get_flattened_data() if is_arm_orange(*pixel))
         if orange > 200:
             break
         time.sleep(1.0)

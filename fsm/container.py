@@ -203,6 +203,8 @@ class Container(State):
 
     @classmethod
     def _currently_opened_container(cls) -> "Container":
+        """The container every construction call acts on (so also where the structure changes)."""
+        introspection.structure_changed()
         if Container._any_containers_opened():
             opened = Container._construction_stack[-1]
             if not isinstance(opened, cls):

@@ -24,6 +24,8 @@ Observer = Callable[[dict], None]
 Hook = Callable[[Any], None]
 
 _hooks: list[Hook] = []
+# Bumped by every construction call anywhere: a structure described before it may be stale.
+_generation = 0
 _tls = threading.local()
 _listening: set[Reporter] = set()
 _listening_lock = threading.Lock()
@@ -41,6 +43,7 @@ class Reporter:
         self._observers: list[Observer] = []
         self._lock = threading.Lock()
         self._owner: int | None = None  # the thread delivering an event right now
+        self._described_at = -1  # the construction generation of the last structure event
 
     @property
     def last_seq(self) -> int:
@@ -49,6 +52,7 @@ class Reporter:
     def add_observer(self, observer: Observer) -> None:
         # Replaced, never mutated: emit iterates the list it read without the lock.
         self._observers = self._observers + [observer]
+        self._described_at = -1  # the newcomer has not seen the structure
         _set_listening(self, True)
 
     def remove_observer(self, observer: Observer) -> None:
@@ -65,25 +69,34 @@ class Reporter:
         me = get_ident()
         if self._owner == me:  # an observer logged: do not recurse into ourselves
             return None
-        with self._lock:
+        lock = self._lock
+        lock.acquire()  # not `with`: this is the hot path of every observed step
+        try:
             self._owner = me
             self._seq = seq = self._seq + 1
-            event = {"v": SCHEMA_VERSION, "seq": seq, "t": _now(), "run": self.run,
-                     "machine": self.machine, "kind": kind, "path": path}
             if fields:
-                event.update(fields)
+                event = {"v": SCHEMA_VERSION, "seq": seq, "t": _now(), "run": self.run,
+                         "machine": self.machine, "kind": kind, "path": path, **fields}
+            else:
+                event = {"v": SCHEMA_VERSION, "seq": seq, "t": _now(), "run": self.run,
+                         "machine": self.machine, "kind": kind, "path": path}
             for observer in observers:
                 try:
                     observer(event)
                 except Exception:
                     sys.stderr.write("fsm: an observer failed:\n" + traceback.format_exc())
+        finally:
             self._owner = None
+            lock.release()
         return event
 
     def begin_run(self) -> None:
-        """Called by the root container as it starts: a new run id, then the structure."""
+        """Called by the root container as it starts: a new run id, then the structure if it
+        changed since it was last sent (or an observer joined since)."""
         self.run = uuid.uuid4().hex[:12]
-        self.emit("structure", self.root_path, {"root": self.structure()})
+        if self._described_at != _generation:
+            self._described_at = _generation
+            self.emit("structure", self.root_path, {"root": self.structure()})
 
     def structure(self) -> dict:
         """Bind every state of the tree to this reporter and describe the tree (docs/events.md)."""
@@ -112,6 +125,12 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
                            for outcome, frm, to in state.get_internal_edges()]
     node.update(state._introspection_info())
     return node
+
+
+def structure_changed() -> None:
+    """A container was built or changed: the next run of every observed machine re-describes it."""
+    global _generation
+    _generation += 1
 
 
 def attach(machine: Any, observer: Observer | None = None, name: str | None = None,

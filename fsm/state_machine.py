@@ -243,6 +243,7 @@ class StateMachine(Container):
             log.logwarn("Attempting to set initial state to include more than one state, but the StateMachine container can only have one initial state. Taking the first one.")
         if len(initial_states) > 0:
             self._initial_state_label = initial_states[0]
+            introspection.structure_changed()
         if userdata is not None:
             self.userdata.update(userdata)
 

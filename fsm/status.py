@@ -60,7 +60,7 @@ class Status:
             if root:
                 self.running, self.outcome, self.error = True, None, None
         elif kind == "transition":
-            entry["active"] = list(event["active"])
+            entry["active"] = event["active"]  # events are never changed once emitted: no copy
         elif kind == "userdata":
             entry["userdata"].update(event["changes"])
         elif kind == "terminate":

@@ -85,9 +85,35 @@ def test_a_rerun_gets_a_new_run_id_and_continues_the_sequence(observe):
     sm.execute()
     first = len(events)
     sm.execute()
-    assert events[first]["kind"] == "structure"
+    assert events[first]["kind"] == "start"
     assert events[first]["run"] != events[0]["run"]
     assert events[first]["seq"] == events[first - 1]["seq"] + 1
+
+
+def test_an_unchanged_machine_is_described_once_across_runs(observe):
+    sm = _nested()
+    events = observe(sm)
+    sm.execute()
+    sm.execute()
+    assert [e["kind"] for e in events].count("structure") == 1
+
+
+def test_the_structure_is_sent_again_after_the_tree_changes(observe):
+    sm = _nested()
+    events = observe(sm)
+    sm.execute()
+    sm.set_initial_state(["FOO"])
+    first = len(events)
+    sm.execute()
+    assert events[first]["kind"] == "structure"
+
+
+def test_an_observer_that_joins_later_is_sent_the_structure(observe):
+    sm = _nested()
+    sm.execute()
+    late = observe(sm)
+    sm.execute()
+    assert late[0]["kind"] == "structure"
 
 
 def test_structure_describes_the_tree_with_paths_sorted_lists_and_transitions(observe):

@@ -11,11 +11,13 @@ from typing import Annotated, Any
 import orjson
 from fastapi import Body, Depends, FastAPI, HTTPException, Path, Query, Request, WebSocket
 from fastapi.concurrency import run_in_threadpool
+from fastapi.openapi.docs import get_swagger_ui_html
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, RedirectResponse, Response
 from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.websockets import WebSocketDisconnect
+from swagger_ui_bundle import swagger_ui_path
 
 from . import models
 from .control import ControlError, find_node, publish
@@ -68,7 +70,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
         yield
         await hub.close()
 
-    app = FastAPI(title=title, version="1", lifespan=lifespan,
+    app = FastAPI(title=title, version="1", lifespan=lifespan, docs_url=None, redoc_url=None,
                   description="Live view and control of fsm state machines (docs/api.md).")
     app.state.settings = settings
     app.state.hub = hub
@@ -117,6 +119,17 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
         if root and os.path.isfile(os.path.join(root, "index.html")):
             return FileResponse(os.path.join(root, "index.html"), headers={"Cache-Control": "no-cache"})
         return HTMLResponse(_PLACEHOLDER)
+
+    # OpenAPI's page, with Swagger UI served from the swagger-ui-bundle package: a robot's
+    # network reaches no CDN, so FastAPI's default page would stay blank there.
+    app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")
+
+    @app.get("/docs", include_in_schema=False)
+    async def docs() -> HTMLResponse:
+        return get_swagger_ui_html(openapi_url=app.openapi_url, title=title + " API",
+                                   swagger_js_url="/docs-assets/swagger-ui-bundle.js",
+                                   swagger_css_url="/docs-assets/swagger-ui.css",
+                                   swagger_favicon_url="/docs-assets/favicon-32x32.png")
 
     # REST.
     @app.get("/api/health", response_model=models.Health, tags=["meta"])

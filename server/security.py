@@ -127,6 +127,7 @@ class SecurityMiddleware:
             scope["fsmscope.raw_send"] = send
             await self.app(scope, receive, send)
             return
+        send = _hardened(send)
         if scope["method"] in ("POST", "PUT", "PATCH", "DELETE"):
             limit = self.settings.max_body
             length = headers.get("content-length")
@@ -162,6 +163,20 @@ class SecurityMiddleware:
             await self.app(scope, replay, send)
             return
         await self.app(scope, receive, send)
+
+
+# No other site may frame the dashboard (a Preempt button under someone else's page), sniff
+# a type, or learn our URL (it carries the token) from a Referer.
+_HARDENING = [(b"x-frame-options", b"DENY"), (b"content-security-policy", b"frame-ancestors 'none'"),
+              (b"x-content-type-options", b"nosniff"), (b"referrer-policy", b"no-referrer")]
+
+
+def _hardened(send: Any) -> Any:
+    async def hardened_send(message: dict) -> None:
+        if message["type"] == "http.response.start":
+            message = dict(message, headers=list(message.get("headers", ())) + _HARDENING)
+        await send(message)
+    return hardened_send
 
 
 async def _json(send: Any, status: int, detail: str) -> None:

@@ -36,6 +36,19 @@ def test_foreign_host_header_is_400(live_server):
     assert answer.status_code == 400
 
 
+def test_docs_page_loads_swagger_ui_from_this_server_not_a_cdn(live_server):
+    page = httpx.get(live_server.base_url + "/docs")
+    assert page.status_code == 200
+    assert "https://" not in page.text and "/docs-assets/swagger-ui-bundle.js" in page.text
+    assert httpx.get(live_server.base_url + "/docs-assets/swagger-ui-bundle.js").status_code == 200
+
+
+def test_pages_may_not_be_framed_by_other_sites(live_server):
+    headers = httpx.get(live_server.base_url + "/").headers
+    assert headers["x-frame-options"] == "DENY"
+    assert headers["content-security-policy"] == "frame-ancestors 'none'"
+
+
 def test_lists_machines(live_server):
     live_server.hub.add_local(two_state_machine(), name="two")
     [info] = client(live_server).get("/api/machines").json()

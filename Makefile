@@ -31,9 +31,14 @@ demo: install
 test: install
 	$(PY) -m pytest -q
 
+# Every benchmark prints a table (medians) against its target; all of them take ~10 minutes.
 bench: install
 	$(PY) bench/runtime.py
 	$(PY) bench/replay.py
+	$(PY) bench/server.py
+	$(PY) bench/graph.py
+	$(PY) bench/sim.py
+	$(PY) bench/demo_cpu.py
 
 clean:
 	rm -rf $(VENV) *.egg-info .pytest_cache

@@ -2,8 +2,9 @@
 VENV     := .venv
 PY       := $(VENV)/bin/python
 STAMP    := $(VENV)/.installed
-# Debian packages the tests and the demo need: Graphviz's dot for graph layout, Chromium for browser tests.
-APT_PKGS := graphviz chromium fonts-dejavu-core
+# Debian packages the tests and the demo need: Graphviz's dot for graph layout, Chromium and
+# Firefox ESR for the browser tests.
+APT_PKGS := graphviz chromium firefox-esr fonts-dejavu-core
 
 .PHONY: install apt demo test bench clean
 

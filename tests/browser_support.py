@@ -71,3 +71,107 @@ class DemoProcess:
             self.rest = self.proc.stdout.read()
             self.proc.stdout.close()
         return self.proc.returncode
+
+
+FIREFOX = "/usr/bin/firefox-esr"
+# Nothing outside this machine is reachable: keep Firefox from trying.
+_FIREFOX_PREFS = """
+user_pref("app.normandy.enabled", false);
+user_pref("app.update.enabled", false);
+user_pref("browser.safebrowsing.malware.enabled", false);
+user_pref("browser.safebrowsing.phishing.enabled", false);
+user_pref("datareporting.policy.dataSubmissionEnabled", false);
+user_pref("network.connectivity-service.enabled", false);
+user_pref("services.settings.server", "http://127.0.0.1:9/");
+user_pref("toolkit.telemetry.enabled", false);
+"""
+
+
+class Firefox:
+    """Debian's Firefox ESR driven over WebDriver BiDi, which it speaks natively (Playwright
+    drives only its own Firefox build, and Debian has no geckodriver)."""
+
+    def __init__(self, width: int = 1280, height: int = 800, timeout: float = 30.0) -> None:
+        import tempfile
+
+        from websockets.sync.client import connect
+
+        self._dir = tempfile.TemporaryDirectory()
+        profile = Path(self._dir.name) / "profile"
+        profile.mkdir()
+        (profile / "user.js").write_text(_FIREFOX_PREFS)
+        self._log = open(Path(self._dir.name) / "firefox.log", "w+")
+        self.proc = subprocess.Popen([FIREFOX, "--headless", "--no-remote", "--profile", str(profile),
+                                      "--remote-debugging-port", "0", "--window-size=%d,%d" % (width, height)],
+                                     stdout=self._log, stderr=subprocess.STDOUT, start_new_session=True)
+        url = self._wait_for_bidi(timeout)
+        self._ws = connect(url + "/session", max_size=None, open_timeout=timeout)
+        self._id = 0
+        self.command("session.new", {"capabilities": {}})
+        self.context = self.command("browsingContext.getTree", {})["contexts"][0]["context"]
+
+    def _wait_for_bidi(self, timeout: float) -> str:
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            self._log.seek(0)
+            found = re.search(r"WebDriver BiDi listening on (ws://\S+)", self._log.read())
+            if found:
+                return found.group(1)
+            if self.proc.poll() is not None:
+                break
+            time.sleep(0.1)
+        self.close()
+        raise RuntimeError("Firefox did not start WebDriver BiDi")
+
+    def command(self, method: str, params: dict) -> dict:
+        import json
+
+        self._id += 1
+        self._ws.send(json.dumps({"id": self._id, "method": method, "params": params}))
+        while True:
+            message = json.loads(self._ws.recv())
+            if message.get("id") == self._id:
+                if message.get("type") == "error":
+                    raise RuntimeError("%s: %s" % (message.get("error"), message.get("message")))
+                return message["result"]
+
+    def goto(self, url: str) -> None:
+        self.command("browsingContext.navigate", {"context": self.context, "url": url, "wait": "complete"})
+
+    def evaluate(self, expression: str):
+        """The value of a JavaScript expression (strings, numbers, booleans, null)."""
+        result = self.command("script.evaluate", {"expression": expression, "awaitPromise": True,
+                                                  "target": {"context": self.context}})
+        if result.get("type") == "exception":
+            raise RuntimeError(result["exceptionDetails"]["text"])
+        return result["result"].get("value")
+
+    def wait_for(self, expression: str, timeout: float = 15.0):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            value = self.evaluate(expression)
+            if value:
+                return value
+            time.sleep(0.1)
+        raise TimeoutError("never true in Firefox: " + expression)
+
+    def screenshot(self, path: Path) -> None:
+        import base64
+
+        data = self.command("browsingContext.captureScreenshot", {"context": self.context})["data"]
+        Path(path).write_bytes(base64.b64decode(data))
+
+    def close(self) -> None:
+        try:
+            self._ws.close()
+        except Exception:
+            pass
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGTERM)
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait()
+        self._log.close()
+        self._dir.cleanup()

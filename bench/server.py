@@ -15,17 +15,18 @@ import json
 import multiprocessing as mp
 import os
 import resource
-import socket
 import statistics
 import sys
 import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests"))
 
 import fsm  # noqa: E402
 from fsm.encoding import dumps  # noqa: E402
 from server.introspection_server import ServerThread  # noqa: E402
+from server_support import stalled_stream  # noqa: E402  (the stalled browser of the tests)
 
 
 def rss_mb():
@@ -184,16 +185,6 @@ def loop_machine(n):
     return sm, counter
 
 
-def stalled_socket(srv, name):
-    raw = socket.create_connection(("127.0.0.1", srv.port))
-    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    raw.sendall(("GET /api/machines/%s/stream?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
-                 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13"
-                 "\r\n\r\n" % (name, srv.token, srv.port)).encode())
-    raw.recv(100)
-    return raw
-
-
 def _reader(url, ready):
     """A healthy client: reads every frame until the stream has been quiet for 3 s."""
     async def main():
@@ -219,7 +210,7 @@ def transition_rate(client, n=100_000):
     srv.hub.add_local(sm, name="loop")
     raw = proc = None
     if client == "stalled":
-        raw = stalled_socket(srv, "loop")
+        raw = stalled_stream(srv, "loop")
     elif client == "healthy":
         ctx = mp.get_context("spawn")
         ready = ctx.Queue()
@@ -254,7 +245,7 @@ def stall_memory(seconds):
         fsm.StateMachine.add("A", fsm.CBState(step, outcomes=["again", "stop"], output_keys=["blob"]),
                              {"again": "A", "stop": "done"})
     entry = srv.hub.add_local(sm, name="stall")
-    raw = stalled_socket(srv, "stall")
+    raw = stalled_stream(srv, "stall")
     thread = threading.Thread(target=sm.execute, daemon=True)
     before = rss_mb()
     thread.start()

@@ -1,0 +1,111 @@
+"""Userdata, feedback and items are encoded JSON-safe (docs/events.md, "Encoding values"); never pickled."""
+
+import dataclasses
+import enum
+import json
+import math
+
+import fsm
+import numpy as np
+from fsm.encoding import DEFAULT_CAP, encode, encode_userdata
+from hypothesis import given
+from hypothesis import strategies as st
+
+
+def strict_json(value) -> str:
+    return json.dumps(value, allow_nan=False)
+
+
+class Color(enum.Enum):
+    RED = 1
+
+
+@dataclasses.dataclass
+class Pose:
+    x: float
+    y: float
+    tags: tuple
+
+
+def test_json_values_pass_through_unchanged():
+    value = {"a": [1, 2.5, "s", None, True], "b": {"c": False}}
+    assert encode(value) == value
+
+
+def test_tuples_and_sets_become_lists():
+    assert encode((1, 2)) == [1, 2]
+    assert encode({3}) == [3]
+
+
+def test_dict_keys_that_are_not_strings_become_strings():
+    assert encode({1: "a", (2, 3): "b"}) == {"1": "a", "(2, 3)": "b"}
+
+
+def test_non_finite_floats_become_strings():
+    assert encode([math.nan, math.inf, -math.inf]) == ["NaN", "Infinity", "-Infinity"]
+
+
+def test_integers_beyond_64_bits_become_strings():
+    assert encode(2 ** 70) == str(2 ** 70)
+
+
+def test_dataclasses_become_dicts_of_their_fields():
+    assert encode(Pose(1.0, 2.0, ("a",))) == {"x": 1.0, "y": 2.0, "tags": ["a"]}
+
+
+def test_enums_become_class_dot_name():
+    assert encode(Color.RED) == "Color.RED"
+
+
+def test_numpy_arrays_and_scalars_become_lists_and_numbers():
+    assert encode(np.array([[1, 2], [3, 4]])) == [[1, 2], [3, 4]]
+    assert encode(np.float32(0.5)) == 0.5
+
+
+def test_other_objects_become_a_truncated_repr():
+    class Thing:
+        def __repr__(self):
+            return "T" * 500
+    encoded = encode(Thing())
+    assert set(encoded) == {"$repr"} and encoded["$repr"].startswith("TTT") and len(encoded["$repr"]) <= 203
+
+
+def test_a_raising_repr_does_not_raise():
+    class Broken:
+        def __repr__(self):
+            raise RuntimeError("no")
+    assert "unrepresentable" in encode(Broken())["$repr"]
+
+
+def test_a_value_over_the_cap_becomes_a_truncation_marker():
+    encoded = encode(list(range(10_000)))
+    assert encoded["$truncated"] is True and encoded["size"] > DEFAULT_CAP and len(encoded["repr"]) <= 203
+
+
+def test_nesting_deeper_than_sixteen_levels_is_cut():
+    value = []
+    for _ in range(40):
+        value = [value]
+    text = strict_json(encode(value, cap=None))
+    assert "$repr" in text
+
+
+def test_a_read_only_input_is_encoded_as_the_value_it_wraps():
+    assert encode(fsm.Const(Pose(0.0, 1.0, ()))) == {"x": 0.0, "y": 1.0, "tags": []}
+
+
+def test_userdata_keys_are_encoded_one_by_one_under_the_cap():
+    encoded = encode_userdata({"small": 1, "big": "x" * (DEFAULT_CAP + 1)})
+    assert encoded["small"] == 1 and encoded["big"]["$truncated"] is True
+
+
+json_like = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats() | st.text() | st.binary(),
+    lambda children: st.lists(children) | st.tuples(children, children) | st.dictionaries(
+        st.text() | st.integers(), children),
+    max_leaves=30)
+
+
+@given(json_like)
+def test_any_nested_value_encodes_to_strict_json(value):
+    strict_json(encode(value))

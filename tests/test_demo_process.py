@@ -46,3 +46,40 @@ def test_a_signal_stops_the_demo_with_its_log_closed_and_complete(tmp_path, sign
     summary = json.loads(replay.stdout)
     assert summary["machines"]["pick_place"]["outcome"] in ("preempted", "succeeded")
     assert not summary.get("problems"), summary["problems"]  # no cut-off or corrupt line
+
+
+def api(demo, method: str, path: str, body: dict | None = None) -> tuple[int, dict]:
+    import httpx
+
+    answer = httpx.request(method, demo.url.split("/?")[0] + path, json=body,
+                           headers={"Authorization": "Bearer " + demo.token}, timeout=10)
+    return answer.status_code, answer.json()
+
+
+def wait_for_machine(demo, predicate, timeout: float = 30.0) -> dict:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        machine = {m["name"]: m for m in api(demo, "GET", "/api/machines")[1]}.get("pick_place")
+        if machine is not None and predicate(machine):
+            return machine
+        time.sleep(0.1)
+    raise TimeoutError("pick_place never reached the expected state")
+
+
+@pytest.mark.timeout(120)
+def test_preempting_the_demo_halts_the_episode_and_start_runs_the_next(tmp_path):
+    from browser_support import DemoProcess
+
+    demo = DemoProcess(tmp_path / "demo.jsonl")
+    try:
+        wait_for_machine(demo, lambda m: m["running"])
+        status, answer = api(demo, "POST", "/api/machines/pick_place/preempt", {"reason": "test"})
+        assert status == 202 and isinstance(answer["seq"], int)
+        stopped = wait_for_machine(demo, lambda m: not m["running"])
+        assert stopped["outcome"] == "preempted"
+        time.sleep(1.0)  # the loop waits for Start instead of going on by itself
+        assert not wait_for_machine(demo, lambda m: True)["running"]
+        assert api(demo, "POST", "/api/machines/pick_place/start", {})[0] == 202
+        wait_for_machine(demo, lambda m: m["running"])
+    finally:
+        assert demo.stop() == 130

@@ -99,6 +99,8 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
 
     def local(entry: MachineEntry) -> Any:
         if entry.handle is None:
+            if entry.source == "replay":
+                raise HTTPException(409, "machine %r is a recording being replayed: nothing to control" % entry.name)
             raise HTTPException(409, "machine %r runs in another process: control it there" % entry.name)
         return entry.handle
 

@@ -104,10 +104,19 @@ def _replay_arguments(parser: argparse.ArgumentParser) -> None:
                         help="tail a log still being written, until its writer closes it")
     parser.add_argument("--no-transcript", action="store_true", help="print only the summary")
     parser.add_argument("--no-time", action="store_true", help="leave the timestamps out of the transcript")
+    parser.add_argument("--serve", action="store_true",
+                        help="replay into the dashboard instead of the terminal (view only)")
+    parser.add_argument("--speed", type=float, default=1.0,
+                        help="with --serve: pace relative to the recording (default 1; 0: as fast as possible)")
+    from .serve import add_server_arguments
+    add_server_arguments(parser, 0)
 
 
 @subcommand("replay", "print a recorded run as SMACH's log lines, then its statistics", _replay_arguments)
 def replay(args: argparse.Namespace) -> int:
+    if args.serve:
+        from .serve import replay_in_browser
+        return replay_in_browser(args)
     import json
 
     from fsm.log_reader import LogError, Reader, follow, read_events

@@ -368,15 +368,16 @@ class Hub:
             self._drain()
 
     # Ingest (on the loop).
-    def ingest(self, event: dict) -> str | None:
-        """Apply one event from another process; returns an error text for a refused event."""
+    def ingest(self, event: dict, source: str = "ingest") -> str | None:
+        """Apply one event from another process (or, ``source="replay"``, from a log); returns an
+        error text for a refused event."""
         name = event["machine"]
         with self._lock:
             entry = self._machines.get(name)
             if entry is None:
-                entry = self._machines[name] = MachineEntry(self, name, "ingest")
-        if entry.source != "ingest":
-            return "machine %r is served by this process" % name
+                entry = self._machines[name] = MachineEntry(self, name, source)
+        if entry.source != source:
+            return "machine %r is served by this process as %s" % (name, entry.source)
         if event["kind"] == "snapshot":
             status = Status.from_dict(dict(event["status"], machine=name))
             status.last_seq = event["seq"]

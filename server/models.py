@@ -29,7 +29,7 @@ class MachineInfo(BaseModel):
     last_seq: int
     root_path: Optional[str] = None
     can_start: bool
-    source: Literal["local", "ingest"]
+    source: Literal["local", "ingest", "replay"]
 
 
 class Transition(BaseModel):

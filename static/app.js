@@ -397,7 +397,8 @@ function updateControls() {
   const entry = currentEntry();
   const running = app.status ? app.status.running : false;
   const live = app.online && app.stream?.state === "live";
-  $("preempt-btn").disabled = !live || !running || entry?.source === "ingest";
+  // Only a machine of the serving process can be controlled (not another process's, not a replay).
+  $("preempt-btn").disabled = !live || !running || entry?.source !== "local";
   $("start-btn").disabled = !live || running || !entry || !entry.can_start;
   const pill = $("run-state");
   let text = "—";
@@ -426,7 +427,12 @@ function updateBadge() {
     cls = "live";
     const rate = stream.rate();
     const lat = stream.latencyMs;
-    text = `live · ${rate < 10 ? rate.toFixed(1) : Math.round(rate)} ev/s · ${lat === null ? "–" : lat < 10 ? lat.toFixed(1) : Math.round(lat)} ms`;
+    const shownRate = rate < 10 ? rate.toFixed(1) : Math.round(rate);
+    if (currentEntry()?.source === "replay") {
+      text = `replay · ${shownRate} ev/s`; // a recording's timestamps say nothing of latency
+    } else {
+      text = `live · ${shownRate} ev/s · ${lat === null ? "–" : lat < 10 ? lat.toFixed(1) : Math.round(lat)} ms`;
+    }
   } else if (state === "reconnecting" || state === "connecting") {
     cls = "wait";
     text = app.online ? state + "…" : "server unreachable · retrying";

@@ -167,3 +167,25 @@ def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(
             proc.wait()
     summary = json.loads(cli("replay", log, "--json").stdout)
     assert summary["machines"]["foo_bar"]["runs"] == 2 and summary["machines"]["foo_bar"]["outcome"] == "end"
+
+
+def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_log):
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve",
+                             "--speed", "0", "--token", "replay-token"],
+                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        url = None
+        for line in proc.stderr:
+            found = re.search(r"still serving at (http://\S+)/\?token=", line)
+            if found:
+                url = found.group(1)
+                break
+        assert url, "no URL printed"
+        headers = {"Authorization": "Bearer replay-token"}
+        machines = {m["name"]: m for m in httpx.get(url + "/api/machines", headers=headers).json()}
+        assert machines["foo_bar"]["source"] == "replay" and machines["foo_bar"]["outcome"] == "end"
+        preempt = httpx.post(url + "/api/machines/foo_bar/preempt", json={}, headers=headers)
+        assert preempt.status_code == 409 and "replayed" in preempt.json()["detail"]
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        assert proc.wait(20) == 0

@@ -1,0 +1,77 @@
+"""A recording replayed into the dashboard (`fsmscope replay LOG --serve`), seen in Chromium."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+
+import fsm
+import pytest
+from browser_support import CHROMIUM, ROOT, launch_chromium
+
+ACTIVE_LEAF = """() => {
+    const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
+    ids.sort((a, b) => b.length - a.length);
+    return ids[0] || null;
+}"""
+
+
+def record_slow_machine(path) -> None:
+    """A -> B -> C, 0.4 s each, recorded for real."""
+    def slow(ud):
+        time.sleep(0.4)
+        return "next"
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(slow, outcomes=["next"]), transitions={"next": "B"})
+        fsm.StateMachine.add("B", fsm.CBState(slow, outcomes=["next"]), transitions={"next": "C"})
+        fsm.StateMachine.add("C", fsm.CBState(slow, outcomes=["next"]), transitions={"next": "done"})
+    recorder = fsm.Recorder(path)
+    fsm.attach(sm, recorder, name="slow")
+    sm.execute()
+    recorder.close()
+
+
+@pytest.fixture
+def replay_url(tmp_path):
+    if not os.path.exists(CHROMIUM):
+        pytest.skip("Debian's chromium is not installed (make apt)")
+    log = tmp_path / "slow.jsonl"
+    record_slow_machine(log)
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve", "--speed", "1"],
+                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        for line in proc.stderr:
+            found = re.search(r"replaying \S+ at (http://\S+)", line)
+            if found:
+                yield found.group(1)
+                break
+        else:
+            pytest.fail("fsmscope replay --serve printed no URL")
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        proc.wait(20)
+
+
+@pytest.mark.timeout(60)
+def test_a_replayed_run_plays_in_the_dashboard_as_a_view_only_replay(replay_url):
+    playwright_api = pytest.importorskip("playwright.sync_api")
+    with playwright_api.sync_playwright() as pw:
+        browser = launch_chromium(pw)
+        page = browser.new_page(viewport={"width": 1280, "height": 800})
+        page.set_default_timeout(15000)
+        page.goto(replay_url)
+        page.wait_for_selector("#graph svg")
+        seen = set()
+        deadline = time.monotonic() + 10
+        while time.monotonic() < deadline and not {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen:
+            seen.add(page.evaluate(ACTIVE_LEAF))
+            time.sleep(0.05)
+        assert {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen, seen
+        assert page.text_content("#badge .badge-text").startswith("replay")
+        assert page.is_disabled("#preempt-btn")
+        browser.close()

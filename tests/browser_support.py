@@ -18,6 +18,12 @@ CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic"
                  "--disable-background-networking", "--disable-component-update", "--disable-sync",
                  "--enable-unsafe-swiftshader"]
 ROOT = Path(__file__).resolve().parents[1]
+# The id of the deepest state the graph highlights as active (a JavaScript expression), or null.
+ACTIVE_LEAF = """(() => {
+    const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
+    ids.sort((a, b) => b.length - a.length);
+    return ids[0] || null;
+})()"""
 FSMSCOPE = [sys.executable, "-m", "server.cli"]
 
 

@@ -17,7 +17,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
-from browser_support import CHROMIUM, free_port, launch_chromium
+from browser_support import ACTIVE_LEAF, CHROMIUM, free_port, launch_chromium
 
 XSS = "<img src=x onerror=alert(1)>"
 ROOT = Path(__file__).resolve().parents[1]
@@ -167,11 +167,7 @@ def page(browser, server):
 
 def active_leaf(page) -> str | None:
     """The deepest state path drawn active in the graph."""
-    return page.evaluate("""() => {
-        const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
-        ids.sort((a, b) => b.length - a.length);
-        return ids[0] || null;
-    }""")
+    return page.evaluate(ACTIVE_LEAF)
 
 
 def ensure_running(page, server) -> None:

@@ -7,19 +7,13 @@ import os
 import time
 
 import pytest
-from browser_support import CHROMIUM, DemoProcess, launch_chromium
+from browser_support import ACTIVE_LEAF, CHROMIUM, DemoProcess, launch_chromium
 
 # The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
 # clearly red > green > blue.
 def is_arm_orange(r: int, g: int, b: int) -> bool:
     return r > 120 and r - b > 90 and r > g > b and g - b > 25
 
-
-ACTIVE_LEAF = """() => {
-    const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
-    ids.sort((a, b) => b.length - a.length);
-    return ids[0] || null;
-}"""
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +59,7 @@ def test_demo_page_draws_the_arm_in_the_3d_view(page):
 
 @pytest.mark.timeout(90)
 def test_demo_graph_highlights_the_running_state_as_the_arm_moves(page):
-    page.wait_for_function(f"({ACTIVE_LEAF})() !== null")
+    page.wait_for_function(ACTIVE_LEAF + " !== null")
     seen = {page.evaluate(ACTIVE_LEAF)}
     deadline = time.monotonic() + 30
     while len(seen) < 3 and time.monotonic() < deadline:

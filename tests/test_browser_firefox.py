@@ -8,15 +8,9 @@ import time
 
 import fsm
 import pytest
-from browser_support import FIREFOX, ROOT, Firefox
+from browser_support import ACTIVE_LEAF, FIREFOX, ROOT, Firefox
 
 XSS = "<img src=x onerror=alert(1)>"
-ACTIVE_LEAF = """(() => {
-    const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
-    ids.sort((a, b) => b.length - a.length);
-    return ids[0] || null;
-})()"""
-
 
 def looping_machine() -> fsm.StateMachine:
     """A -> XSS-named state -> A ..., until shut down."""

@@ -11,13 +11,7 @@ import time
 
 import fsm
 import pytest
-from browser_support import CHROMIUM, ROOT, launch_chromium
-
-ACTIVE_LEAF = """() => {
-    const ids = [...document.querySelectorAll('#graph g.node.active')].map(g => g.id);
-    ids.sort((a, b) => b.length - a.length);
-    return ids[0] || null;
-}"""
+from browser_support import ACTIVE_LEAF, CHROMIUM, ROOT, launch_chromium
 
 
 def record_slow_machine(path) -> None:

@@ -128,13 +128,6 @@ class Recorder:
         self._buf += _dumps_line(event)
         self.snapshots += 1
 
-    def snapshot_now(self) -> None:
-        """Write a snapshot of every machine now (e.g. before a long pause)."""
-        with self._lock:
-            if not self._closed:
-                for status in self._statuses.values():
-                    self._snapshot(status)
-
     # Writing.
     def _take(self) -> tuple[bytes, bytes]:
         with self._lock:

@@ -82,10 +82,6 @@ class Status:
             entry["initial"] = list(node.get("initial", []))
             self.containers[node["path"]] = entry
 
-    def active_paths(self) -> list[str]:
-        """Every active state's full path, at every level."""
-        return [p + "/" + label for p, c in self.containers.items() for label in c["active"] if label != "None"]
-
     def to_dict(self) -> dict:
         return {"machine": self.machine, "run": self.run, "root_path": self.root_path, "structure": self.structure,
                 "containers": copy.deepcopy(self.containers), "running": self.running, "outcome": self.outcome,

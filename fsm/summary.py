@@ -27,7 +27,6 @@ class _Machine:
         self.events = 0
         self.first_t: float | None = None
         self.last_t: float | None = None
-        self.run_started: float | None = None
         self.outcome: str | None = None
         self.status = INCOMPLETE
         self.ended_with_error: str | None = None

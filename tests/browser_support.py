@@ -32,6 +32,15 @@ def launch_chromium(playwright):
     return playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
 
 
+def open_page(browser, url: str, width: int = 1280, height: int = 800, timeout_ms: int = 15000):
+    """A new page of ``browser`` at ``width`` x ``height``, loaded from ``url``, showing a graph."""
+    page = browser.new_page(viewport={"width": width, "height": height})
+    page.set_default_timeout(timeout_ms)
+    page.goto(url)
+    page.wait_for_selector("#graph svg")
+    return page
+
+
 def free_port() -> int:
     with socket.socket() as s:
         s.bind(("127.0.0.1", 0))

@@ -7,7 +7,7 @@ import os
 import time
 
 import pytest
-from browser_support import ACTIVE_LEAF, CHROMIUM, DemoProcess, launch_chromium
+from browser_support import ACTIVE_LEAF, CHROMIUM, DemoProcess, launch_chromium, open_page
 
 # The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
 # clearly red > green > blue.
@@ -30,11 +30,8 @@ def page(demo):
     playwright_api = pytest.importorskip("playwright.sync_api")
     with playwright_api.sync_playwright() as pw:
         browser = launch_chromium(pw)
-        page = browser.new_page(viewport={"width": 1600, "height": 900})
-        page.set_default_timeout(20000)
-        page.goto(demo.url)
+        page = open_page(browser, demo.url, 1600, 900, timeout_ms=20000)
         page.wait_for_selector("#badge.live")
-        page.wait_for_selector("#graph svg")
         yield page
         browser.close()
 

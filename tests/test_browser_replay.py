@@ -11,7 +11,7 @@ import time
 
 import fsm
 import pytest
-from browser_support import ACTIVE_LEAF, CHROMIUM, ROOT, launch_chromium
+from browser_support import ACTIVE_LEAF, CHROMIUM, ROOT, launch_chromium, open_page
 
 
 def record_slow_machine(path) -> None:
@@ -56,10 +56,7 @@ def test_a_replayed_run_plays_in_the_dashboard_as_a_view_only_replay(replay_url)
     playwright_api = pytest.importorskip("playwright.sync_api")
     with playwright_api.sync_playwright() as pw:
         browser = launch_chromium(pw)
-        page = browser.new_page(viewport={"width": 1280, "height": 800})
-        page.set_default_timeout(15000)
-        page.goto(replay_url)
-        page.wait_for_selector("#graph svg")
+        page = open_page(browser, replay_url)
         seen = set()
         deadline = time.monotonic() + 10
         while time.monotonic() < deadline and not {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen:

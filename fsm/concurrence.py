@@ -20,6 +20,13 @@ from .worker_pool import pool
 
 
 class Concurrence(Container):
+    """Runs its children at once; its outcome comes from outcome_map, outcome_cb or default_outcome.
+
+    A preempt that every child serviced ends it with 'preempted' if that is one of its outcomes, and
+    otherwise with what that policy gives for the children's outcomes. Fixed against SMACH, which
+    returns 'preempted' even when it is not registered, so that its parent StateMachine raises.
+    """
+
     _kind_name = "Concurrence"
 
     def __init__(self, outcomes: Any, default_outcome: str, input_keys: list[str] = [], output_keys: list[str] = [],
@@ -105,7 +112,8 @@ class Concurrence(Container):
             if serviced:
                 log.loginfo("Concurrence serviced preempt.")
                 self.service_preempt()
-                return self._terminate("preempted", parent_ud)
+                if "preempted" in self._outcomes:
+                    return self._terminate("preempted", parent_ud)
 
         log.info_quiet("Concurrent Outcomes: " + str(self._child_outcomes))
         outcome = self._default_outcome

@@ -37,7 +37,10 @@ class Iterator(Container):
     @staticmethod
     def set_contained_state(label: str, state: State, loop_outcomes: list[str] = [], break_outcomes: list[str] = [],
                             final_outcome_map: dict = {}) -> State:
-        """Outcomes not listed as loop (or break) outcomes do the opposite."""
+        """Outcomes not listed as loop (or break) outcomes do the opposite.
+
+        ``final_outcome_map`` maps the ending outcome, the exhausted outcome included, as in SMACH.
+        """
         self = Iterator._currently_opened_container()
         if loop_outcomes and break_outcomes:
             log.logwarn("Both loop_outcomes and break_outcomes were specified when constructing SMACH iterator container.")
@@ -88,15 +91,17 @@ class Iterator(Container):
                 self._report_changes()
             if self._preempt_requested:
                 self.service_preempt()
-                outcome = self._final_outcome_map.get(state_outcome, state_outcome)
+                outcome = state_outcome
                 break
             if state_outcome in self._break_outcomes or (self._loop_outcomes and state_outcome not in self._loop_outcomes):
-                outcome = self._final_outcome_map.get(state_outcome, state_outcome)
+                outcome = state_outcome
                 break
             if rep is not None:
                 rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(state_outcome),
                                                     "to": str(self._state_label), "active": [str(self._state_label)]})
             self.call_transition_cbs()
+        # As in SMACH, every ending is mapped: a break by the state's outcome, exhaustion by the exhausted outcome.
+        outcome = self._final_outcome_map.get(outcome, outcome)
         self._copy_output_keys(self.userdata, parent_ud)
         self._is_running = False
         self._report("terminate", {"last": [str(self._state_label)],
@@ -113,6 +118,14 @@ class Iterator(Container):
 
     def get_children(self) -> dict:
         return {self._state_label: self._state} if self._state is not None else {}
+
+    def __getitem__(self, key: str) -> State:
+        """SMACH's own wording for its one contained state (singular, unlike the other containers)."""
+        if self._state is None or key != self._state_label:
+            log.logerr("Attempting to get state '%s' from Iterator container. The only available state is '%s'."
+                       % (key, self._state_label))
+            raise KeyError()
+        return self._state
 
     def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
         """Fixed against SMACH (a TypeError for several states): takes the first, merges the userdata."""

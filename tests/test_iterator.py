@@ -97,6 +97,18 @@ def test_custom_exhausted_outcome_is_returned_when_items_run_out():
     assert it.execute() == "empty"
 
 
+def test_an_exhausted_iterator_maps_its_outcome_through_final_outcome_map():
+    it = _iterator([1, 2], Out("next", outcomes=["next"]), outcomes=["done"],
+                   contained={"loop_outcomes": ["next"], "final_outcome_map": {"exhausted": "done"}})
+    assert it.execute() == "done"
+
+
+def test_an_exhausted_iterator_maps_its_exhausted_outcome_not_the_last_state_outcome():
+    it = _iterator([1, 2], Out("next", outcomes=["next"]), outcomes=["stopped"],
+                   contained={"loop_outcomes": ["next"], "final_outcome_map": {"next": "stopped"}})
+    assert it.execute() == "exhausted"
+
+
 def test_transition_callbacks_run_after_each_looping_iteration():
     calls = []
     it = _iterator([1, 2, 3], _summing_body(stop_at=3), outcomes=["stop"], contained={"loop_outcomes": ["next"]})
@@ -177,3 +189,10 @@ def test_iterator_set_initial_state_with_a_wrong_label_warns_and_raises_key_erro
     with pytest.raises(KeyError):
         it.set_initial_state(["NOPE"], smach.UserData())
     assert len(logs.warn) == 1
+
+
+def test_getting_an_unknown_state_from_an_iterator_logs_its_one_state_in_the_singular(logs):
+    it = _iterator([1], Out("next", outcomes=["next"]), contained={"loop_outcomes": ["next"]})
+    with pytest.raises(KeyError):
+        it["NOPE"]
+    assert logs.error == ["Attempting to get state 'NOPE' from Iterator container. The only available state is 'BODY'."]

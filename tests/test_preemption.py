@@ -46,22 +46,29 @@ def test_serviced_preempt_of_the_last_state_is_serviced_by_the_machine(logs):
     assert not sm.preempt_requested()
 
 
-def test_concurrence_returns_preempted_when_every_child_services_the_preempt(logs):
+def test_concurrence_registering_preempted_returns_it_when_every_child_services_the_preempt(logs):
     a, b = WaitForPreempt(), WaitForPreempt()
-    cc = concurrence(["done"], "done", [("A", a), ("B", b)])
+    cc = concurrence(["done", "preempted"], "done", [("A", a), ("B", b)])
     assert preempt_while_running(cc, a, b) == "preempted"
     assert "Concurrence serviced preempt." in logs.info
     assert not cc.preempt_requested()
 
 
-def test_parent_machine_rejects_a_concurrence_preempted_outcome_it_does_not_register(logs):
+def test_concurrence_without_preempted_maps_its_serviced_children_through_its_outcome_policy(logs):
+    a, b = WaitForPreempt(), WaitForPreempt()
+    cc = concurrence(["done", "stopped"], "done", [("A", a), ("B", b)],
+                     outcome_map={"stopped": {"A": "preempted", "B": "preempted"}})
+    assert preempt_while_running(cc, a, b) == "stopped"
+    assert "Concurrence serviced preempt." in logs.info
+    assert not cc.preempt_requested()
+
+
+def test_parent_machine_follows_the_registered_outcome_of_a_serviced_concurrence_without_preempted(logs):
     a = WaitForPreempt()
     cc = concurrence(["done"], "done", [("A", a)])
     sm = machine(["done"], [("CC", cc, {})])
-    with pytest.raises(smach.InvalidTransitionError) as info:
-        preempt_while_running(sm, a)
-    assert str(info.value) == ("Attempted to return outcome 'preempted' from state 'CC' of type '%s' which only "
-                               "has registered outcomes: ('done',)" % cc)
+    assert preempt_while_running(sm, a) == "done"
+    assert not sm.preempt_requested()
 
 
 def test_concurrence_recalls_unserviced_preempts_and_uses_its_outcome_policy(logs):
@@ -76,7 +83,7 @@ def test_concurrence_recalls_unserviced_preempts_and_uses_its_outcome_policy(log
 
 def test_concurrence_preempted_while_idle_starts_its_children_preempted(logs):
     a, b = WaitForPreempt(), WaitForPreempt()
-    cc = concurrence(["done"], "done", [("A", a), ("B", b)])
+    cc = concurrence(["done", "preempted"], "done", [("A", a), ("B", b)])
     cc.request_preempt()
     assert cc.execute() == "preempted"
 

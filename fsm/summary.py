@@ -138,9 +138,10 @@ class Summary:
 
     # Results.
     def exit_code(self) -> int:
-        """0: every machine finished with an outcome; 1: one ended in an error, or never finished."""
+        """0: every machine finished with an outcome; 1: one ended in an error, or never finished;
+        2: not one event (the log is empty or unreadable, which is not a run that failed)."""
         if not self.machines:
-            return 1
+            return 2
         return 0 if all(m.status == FINISHED for m in self.machines.values()) else 1
 
     def to_dict(self) -> dict:

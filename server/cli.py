@@ -15,7 +15,10 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:
+    from fsm.log_reader import Reader
 
 EXIT_OK, EXIT_ERROR, EXIT_UNREADABLE = 0, 1, 2
 
@@ -144,6 +147,8 @@ def replay(args: argparse.Namespace) -> int:
     except KeyboardInterrupt:
         pass
     summary.problems = reader.problems
+    if not summary.machines:
+        print("fsmscope replay: %s" % no_events(reader), file=sys.stderr)
     if args.json:
         data = summary.to_dict()
         data["file"] = args.log
@@ -153,6 +158,14 @@ def replay(args: argparse.Namespace) -> int:
             out.write("\n")
         out.write(summary.format() + "\n")
     return summary.exit_code()
+
+
+def no_events(reader: Reader) -> str:
+    """What is wrong with a log that holds not one complete event (it is unreadable: exit 2)."""
+    if reader.lineno == 0:
+        return "%s: no events (the file is empty)" % reader.path
+    skipped = len(reader.problems)
+    return "%s: no events (%d line%s skipped)" % (reader.path, skipped, "" if skipped == 1 else "s")
 
 
 def build_parser() -> argparse.ArgumentParser:

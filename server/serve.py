@@ -115,6 +115,10 @@ def replay_in_browser(args: argparse.Namespace) -> int:
                 while not any(entry.clients for entry in srv.hub.machines()):
                     time.sleep(0.1)
                 first, start = t, time.monotonic()
+        if not count:
+            from .cli import no_events
+            print("fsmscope replay: %s" % no_events(reader), file=sys.stderr)
+            return 2
         print("fsmscope: replayed %d events; still serving at %s (Ctrl-C stops)" % (count, srv.url),
               file=sys.stderr, flush=True)
         wait_for_interrupt()

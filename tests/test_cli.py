@@ -105,6 +105,31 @@ def test_replay_refuses_an_unknown_schema_version_with_exit_2(tmp_path):
     assert done.returncode == 2 and "schema version 99 is not supported" in done.stderr
 
 
+def test_replay_of_an_empty_file_is_unreadable_with_exit_2(tmp_path):
+    log = tmp_path / "empty.jsonl"
+    log.write_bytes(b"")
+    done = cli("replay", log)
+    assert done.returncode == 2
+    assert "fsmscope replay: %s: no events (the file is empty)" % log in done.stderr
+
+
+def test_replay_of_random_bytes_is_unreadable_with_exit_2(tmp_path):
+    log = tmp_path / "noise.jsonl"
+    log.write_bytes(bytes(range(256)) * 4)  # one newline in each 256 bytes: five lines of noise
+    done = cli("replay", log, "--json")
+    assert done.returncode == 2
+    assert "fsmscope replay: %s: no events (5 lines skipped)" % log in done.stderr
+    assert json.loads(done.stdout)["exit_code"] == 2
+
+
+def test_replay_serve_of_an_empty_file_exits_2_instead_of_serving(tmp_path):
+    log = tmp_path / "empty.jsonl"
+    log.write_bytes(b"")
+    done = cli("replay", log, "--serve", timeout=20)
+    assert done.returncode == 2
+    assert "fsmscope replay: %s: no events (the file is empty)" % log in done.stderr
+
+
 def test_replay_reports_a_truncated_last_line_and_replays_the_rest(foo_bar_log, tmp_path):
     data = foo_bar_log.read_bytes()
     cut = tmp_path / "cut.jsonl"

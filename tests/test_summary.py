@@ -67,8 +67,8 @@ def test_a_run_ending_in_an_error_lists_it_and_exits_1(tmp_path):
     assert summary.exit_code() == 1
 
 
-def test_an_empty_log_exits_1():
-    assert summarize([]).exit_code() == 1
+def test_a_log_without_events_is_unreadable_and_exits_2():
+    assert summarize([]).exit_code() == 2
 
 
 def test_the_text_summary_names_outcome_states_and_transitions():

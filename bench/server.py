@@ -1,11 +1,12 @@
-"""Server benchmarks (medians): event-to-browser latency, fan-out throughput against a bare `websockets`
-server, a machine's transition rate with a stalled client, and the server's memory during the stall.
+"""Server benchmarks (medians): event-to-browser latency, per-request HTTP latency, fan-out throughput
+against a bare `websockets` server, a machine's transition rate with a stalled client, and the server's
+memory during the stall.
 
     .venv/bin/python bench/server.py [--repeat 3] [--stall-seconds 60]
 
 Clients run in a separate process (so they do not share the server's GIL); latency is the client's
 ``time.time()`` on receipt minus the event's ``t`` (same host clock).
-Targets: p99 < 5 ms at 1,000 events/s to 10 clients; >= 0.8 of the bare server's events/s per client with
+Targets: p99 < 5 ms at 1,000 events/s to 10 clients; p50 < 2 ms per GET on one kept-alive connection; >= 0.8 of the bare server's events/s per client with
 50 clients; <= 5 % fewer transitions/s with one stalled client; memory bounded during a stall.
 """
 
@@ -266,14 +267,16 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--stall-seconds", type=float, default=60)
-    parser.add_argument("--only", choices=["latency", "fanout", "rate", "memory"], action="append",
+    parser.add_argument("--only", choices=["latency", "http", "fanout", "rate", "memory"], action="append",
                         help="run only these tables (repeatable; default: all)")
     args = parser.parse_args()
-    only = set(args.only or ["latency", "fanout", "rate", "memory"])
+    only = set(args.only or ["latency", "http", "fanout", "rate", "memory"])
     print("fsmscope server benchmarks, median of %d runs, cores=%d\n" % (args.repeat, os.cpu_count()))
 
     if "latency" in only:
         latency_table(args.repeat)
+    if "http" in only:
+        http_table(args.repeat)
     if "fanout" in only:
         fanout_table(args.repeat)
     if "rate" in only:
@@ -296,6 +299,34 @@ def latency_table(repeat):
                                                              statistics.median(maxs),
                                                              "met" if statistics.median(p99s) < 5 else "MISSED"))
 
+
+def request_times(n=200):
+    """Seconds per GET /api/health, ``n`` sent one after another on one kept-alive connection."""
+    import httpx
+
+    srv = ServerThread().start()
+    times = []
+    with httpx.Client(base_url=srv.base_url, headers={"Authorization": "Bearer " + srv.token}, timeout=5) as http:
+        http.get("/api/health")  # connect outside the timing
+        for _ in range(n):
+            start = time.perf_counter()
+            http.get("/api/health")
+            times.append(time.perf_counter() - start)
+    srv.stop()
+    return times
+
+
+def http_table(repeat):
+    p50s, p99s = [], []
+    for _ in range(max(repeat, 5)):
+        times = request_times()
+        p50s.append(pct(times, 50) * 1000)
+        p99s.append(pct(times, 99) * 1000)
+    p50 = statistics.median(p50s)
+    print("| per-request latency on one kept-alive connection, 200 sequential GET /api/health, median of %d "
+          "| p50 ms | p99 ms | target |" % len(p50s))
+    print("|---|---|---|---|")
+    print("| fsmscope | %.2f | %.2f | p50 < 2 ms: %s |\n" % (p50, statistics.median(p99s), "met" if p50 < 2 else "MISSED"))
 
 
 def fanout_table(repeat):

@@ -26,9 +26,13 @@ def ws_implementation() -> str:
 
 
 def bind_socket(host: str, port: int) -> socket.socket:
+    """The listening socket, made with proto IPPROTO_TCP: asyncio sets TCP_NODELAY on accepted
+    sockets only when their proto says TCP. Without it, Nagle's algorithm holds every response
+    on a kept-alive connection until the client's delayed ACK (~40 ms)."""
     family = socket.AF_INET6 if ":" in host else socket.AF_INET
-    sock = socket.socket(family, socket.SOCK_STREAM)
+    sock = socket.socket(family, socket.SOCK_STREAM, socket.IPPROTO_TCP)
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)  # inherited by accepted sockets on Linux
     sock.bind((host, port))
     sock.listen(128)
     sock.set_inheritable(True)

@@ -63,7 +63,18 @@ function notice(text, level = "info", sticky = false) {
   el.textContent = text;
   el.className = "notice " + level;
   clearTimeout(noticeTimer);
-  if (!sticky) noticeTimer = setTimeout(() => { el.textContent = ""; el.className = "notice"; }, 8000);
+  if (!sticky) noticeTimer = setTimeout(clearNotice, 8000);
+}
+
+function clearNotice() {
+  clearTimeout(noticeTimer);
+  $("notice").textContent = "";
+  $("notice").className = "notice";
+}
+
+/** A notice about machine `name`, dropped when the page has moved to another machine meanwhile. */
+function noticeAbout(name, text, level, sticky) {
+  if (name === app.name) notice(text, level, sticky);
 }
 
 function banner(text) {
@@ -138,7 +149,11 @@ function openMachine(name) {
   app.pendingChanges = new Map();
   app.lastEdge = new Map();
   app.expand = null;
+  // Notices and preempt bookkeeping are about the machine shown so far, not this one.
+  clearNotice();
   app.preemptAsked = false;
+  app.preemptAck = null;
+  app.finishedText = null;
   graph.clear("Waiting for the machine's structure…");
   tree.build(null);
   userdata.show(null);
@@ -191,7 +206,7 @@ function track(ev) {
     case "start":
       if (path === app.status.root_path && app.finishedText) {
         app.finishedText = null;
-        notice("", "info", true); // the previous run's outcome no longer describes the machine
+        clearNotice(); // the previous run's outcome no longer describes the machine
       }
       app.pendingChanges.set(path, new Set());
       app.changed.set(path, new Set());
@@ -355,12 +370,13 @@ function stateMenu(path, x, y) {
 }
 
 async function setInitial(container, state) {
+  const name = app.name;
   const ud = app.status.containers[container]?.userdata || {};
   const ok = await editInitialState({
     container, state, userdata: ud,
-    submit: (value) => api.setInitialState(app.name, container, [state], value),
+    submit: (value) => api.setInitialState(name, container, [state], value),
   });
-  if (ok) notice(`Initial state of ${container} set to ${state} (next run)`, "ok");
+  if (ok) noticeAbout(name, `Initial state of ${container} set to ${state} (next run)`, "ok");
 }
 
 // ---------------------------------------------------------------- controls
@@ -379,17 +395,19 @@ $("preempt-btn").addEventListener("click", async () => {
     app.preemptAck = `Preempt accepted (event ${ack.seq})`;
     notice(app.preemptAck + ": " + (app.finishedText || "waiting for the outcome…"), "warn", true);
   } catch (err) {
+    if (name !== app.name) return;
     app.preemptAsked = false;
     notice("Preempt failed: " + (err.detail || err.message), "error", true);
   }
 });
 
 $("start-btn").addEventListener("click", async () => {
+  const name = app.name;
   try {
-    const ack = await api.start(app.name);
-    notice(`Start accepted (event ${ack.seq})`, "ok");
+    const ack = await api.start(name);
+    noticeAbout(name, `Start accepted (event ${ack.seq})`, "ok");
   } catch (err) {
-    notice("Start failed: " + (err.detail || err.message), "error", true);
+    noticeAbout(name, "Start failed: " + (err.detail || err.message), "error", true);
   }
 });
 

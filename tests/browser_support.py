@@ -5,12 +5,16 @@ from __future__ import annotations
 
 import os
 import re
+import shutil
 import signal
 import socket
 import subprocess
 import sys
 import time
+import urllib.parse
 from pathlib import Path
+
+import pytest
 
 CHROMIUM = "/usr/bin/chromium"
 # No downloads and no GPU here: software WebGL (for viser's scene) and no background networking.
@@ -32,12 +36,38 @@ def launch_chromium(playwright):
     return playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
 
 
+@pytest.fixture(scope="module")
+def browser():
+    """Debian's Chromium, shared by the tests of one module (import this fixture into the module)."""
+    playwright_api = pytest.importorskip("playwright.sync_api")
+    if not os.path.exists(CHROMIUM):
+        pytest.skip("Debian's chromium is not installed (make apt)")
+    if not shutil.which("dot"):
+        pytest.skip("Graphviz's dot is not installed (make apt)")  # the server draws the graph with it
+    with playwright_api.sync_playwright() as pw:
+        chromium = launch_chromium(pw)
+        yield chromium
+        chromium.close()
+
+
 def open_page(browser, url: str, width: int = 1280, height: int = 800, timeout_ms: int = 15000):
-    """A new page of ``browser`` at ``width`` x ``height``, loaded from ``url``, showing a graph."""
+    """A new page of ``browser`` at ``width`` x ``height``, loaded from ``url``, showing a graph.
+
+    ``page.errors`` collects the page's uncaught errors."""
     page = browser.new_page(viewport={"width": width, "height": height})
     page.set_default_timeout(timeout_ms)
+    page.errors = []
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
     page.goto(url)
     page.wait_for_selector("#graph svg")
+    return page
+
+
+def watch(browser, server, machine: str):
+    """A page showing ``machine`` of ``server`` (a ServerThread) with its stream live."""
+    page = open_page(browser, server.url + "#m=" + urllib.parse.quote(machine), timeout_ms=8000)
+    page.wait_for_selector("#badge.live")
+    assert page.input_value("#machine-picker") == machine
     return page
 
 

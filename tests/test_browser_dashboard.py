@@ -7,9 +7,7 @@ outright and start it again on the same port, the way a crashed `fsmscope run` c
 from __future__ import annotations
 
 import json
-import os
 import secrets
-import shutil
 import subprocess
 import sys
 import time
@@ -17,7 +15,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
-from browser_support import ACTIVE_LEAF, CHROMIUM, free_port, launch_chromium
+from browser_support import ACTIVE_LEAF, browser, free_port  # noqa: F401 (browser is a fixture)
 
 XSS = "<img src=x onerror=alert(1)>"
 ROOT = Path(__file__).resolve().parents[1]
@@ -127,23 +125,10 @@ class ServerProcess:
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
     pytest.importorskip("server.introspection_server", reason="the backend (server/) is not there yet")
-    if not shutil.which("dot"):
-        pytest.skip("Graphviz's dot is not installed (make apt)")
     proc = ServerProcess(tmp_path_factory.mktemp("server"))
     proc.start()
     yield proc
     proc.kill()
-
-
-@pytest.fixture(scope="module")
-def browser():
-    playwright_api = pytest.importorskip("playwright.sync_api")
-    if not os.path.exists(CHROMIUM):
-        pytest.skip("Debian's chromium is not installed (make apt)")
-    with playwright_api.sync_playwright() as pw:
-        chromium = launch_chromium(pw)
-        yield chromium
-        chromium.close()
 
 
 @pytest.fixture

@@ -16,8 +16,8 @@ from typing import Any, Callable
 
 from . import log
 from .encoding import encode_userdata
+from .schema import event as _event
 
-SCHEMA_VERSION = 1
 DEFAULT_ROOT_PATH = "/SM_ROOT"
 
 Observer = Callable[[dict], None]
@@ -74,12 +74,7 @@ class Reporter:
         try:
             self._owner = me
             self._seq = seq = self._seq + 1
-            if fields:
-                event = {"v": SCHEMA_VERSION, "seq": seq, "t": _now(), "run": self.run,
-                         "machine": self.machine, "kind": kind, "path": path, **fields}
-            else:
-                event = {"v": SCHEMA_VERSION, "seq": seq, "t": _now(), "run": self.run,
-                         "machine": self.machine, "kind": kind, "path": path}
+            event = _event(seq, _now(), self.run, self.machine, kind, path, fields)
             for observer in observers:
                 try:
                     observer(event)

@@ -18,12 +18,11 @@ from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
 from .encoding import loads
-from .introspection import SCHEMA_VERSION
 from .recorder import fcntl, index_path
+from .schema import VERSION, validate
 from .status import Status
 
-REQUIRED = ("v", "seq", "machine", "kind", "path")
-SUPPORTED_VERSIONS = (SCHEMA_VERSION,)
+SUPPORTED_VERSIONS = (VERSION,)
 
 
 class LogError(Exception):
@@ -96,23 +95,21 @@ class Reader:
                                   % (self.path, self.lineno, version, ", ".join(map(str, SUPPORTED_VERSIONS))))
             self._problem("no schema version ('v')" if version is None else "bad schema version %r" % (version,))
             return None
-        for key in REQUIRED:
-            if key not in event:
-                self._problem("event lacks '%s'" % key)
-                return None
+        problem = validate(event)
+        if problem:
+            self._problem("invalid event: " + problem)
+            return None
         return event
 
     def events(self, handle: Any) -> Iterator[dict]:
         parse = self.parse
-        version = SCHEMA_VERSION
         lineno = self.lineno
         try:
             for raw in handle:
                 lineno += 1
-                try:  # the fast path: a complete, well-formed event
+                try:  # the fast path: a complete, valid event
                     event = loads(raw)
-                    if (type(event) is dict and event.get("v") == version and "kind" in event and "machine" in event
-                            and "path" in event and "seq" in event and raw[-1:] == b"\n"):
+                    if raw[-1:] == b"\n" and validate(event) is None:
                         yield event
                         continue
                 except ValueError:
@@ -233,7 +230,7 @@ def _snapshot_at(handle: Any, offset: int, machine: str, seq: int) -> dict | Non
     except (OSError, ValueError):
         return None
     if (type(event) is dict and event.get("kind") == "snapshot" and event.get("machine") == machine
-            and event.get("seq") == seq and event.get("v") in SUPPORTED_VERSIONS):
+            and event.get("seq") == seq and validate(event) is None):
         return event
     return None
 

@@ -25,7 +25,7 @@ import weakref
 from typing import Any
 
 from . import encoding
-from .introspection import SCHEMA_VERSION
+from . import schema
 from .status import Status
 
 try:
@@ -120,9 +120,8 @@ class Recorder:
         self._snapshot_at[status.machine] = status.last_seq + self.snapshot_every
         if status.root_path is None:  # no structure seen yet: nothing a reader could start from
             return
-        event = {"v": SCHEMA_VERSION, "seq": status.last_seq, "t": time.time(), "run": status.run,
-                 "machine": status.machine, "kind": "snapshot", "path": status.root_path,
-                 "status": status.to_dict()}
+        event = schema.event(status.last_seq, time.time(), status.run, status.machine, "snapshot",
+                             status.root_path, {"status": status.to_dict()})
         offset = self._taken + len(self._buf)
         self._index_chunks.append(_dumps_line({"machine": status.machine, "seq": status.last_seq, "offset": offset}))
         self._buf += _dumps_line(event)

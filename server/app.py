@@ -13,7 +13,7 @@ from fastapi import Body, Depends, FastAPI, HTTPException, Path, Query, Request,
 from fastapi.concurrency import run_in_threadpool
 from fastapi.openapi.docs import get_swagger_ui_html
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, RedirectResponse, Response
+from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.websockets import WebSocketDisconnect
@@ -22,8 +22,8 @@ from swagger_ui_bundle import swagger_ui_path
 from . import models
 from .control import ControlError, find_node, publish
 from .hub import Hub, MachineEntry
-from .security import (COOKIE, SecurityMiddleware, Settings, deny_websocket, require_token,
-                       websocket_refusal)
+from .security import (SecurityMiddleware, Settings, deny_websocket, require_token, websocket_refusal,
+                       websocket_subprotocol)
 
 ERRORS = {code: {"model": models.Error} for code in (400, 401, 403, 404, 409, 413, 422)}
 NAME = Path(min_length=1, max_length=200, description="machine name")
@@ -70,8 +70,8 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
         yield
         await hub.close()
 
-    app = FastAPI(title=title, version="1", lifespan=lifespan, docs_url=None, redoc_url=None,
-                  description="Live view and control of fsm state machines (docs/api.md).")
+    app = _App(title=title, version="1", lifespan=lifespan, docs_url=None, redoc_url=None,
+               description="Live view and control of fsm state machines (docs/api.md).")
     app.state.settings = settings
     app.state.hub = hub
 
@@ -83,6 +83,10 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     @app.exception_handler(RequestValidationError)
     async def validation_error(request: Request, exc: RequestValidationError) -> JSONResponse:
         return JSONResponse({"detail": _validation_message(exc)}, status_code=422)
+
+    @app.exception_handler(Exception)
+    async def unexpected_error(request: Request, exc: Exception) -> JSONResponse:
+        return JSONResponse({"detail": "internal error (%s)" % type(exc).__name__}, status_code=500)
 
     @app.exception_handler(ControlError)
     async def control_error(request: Request, exc: ControlError) -> JSONResponse:
@@ -109,14 +113,8 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
 
     # Pages.
     @app.get("/", include_in_schema=False)
-    async def index(request: Request) -> Response:
-        given = request.query_params.get("token")
-        if given is not None:
-            if not settings.token_ok(given):
-                raise HTTPException(401, "wrong token")
-            response = RedirectResponse("/", status_code=303)
-            response.set_cookie(COOKIE, given, httponly=True, samesite="strict")
-            return response
+    async def index() -> Response:
+        """The page holds no data; it takes the token from its URL (static/token.js)."""
         root = static_dir()
         if root and os.path.isfile(os.path.join(root, "index.html")):
             return FileResponse(os.path.join(root, "index.html"), headers={"Cache-Control": "no-cache"})
@@ -152,7 +150,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
             out.append({"name": entry.name, "running": entry.running(), "outcome": status.outcome,
                         "last_seq": status.last_seq, "root_path": status.root_path,
                         "can_start": bool(entry.handle is not None and entry.handle.can_start),
-                        "source": entry.source})
+                        "source": entry.source, "connected": entry.connected, "rejected": entry.rejected})
         return out
 
     @app.get("/api/machines/{name}/structure", response_model=models.StructureNode, dependencies=auth,
@@ -251,7 +249,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
         if entry is None:
             await deny_websocket(websocket, 404, "no machine named %r" % name)
             return
-        await websocket.accept()
+        await websocket.accept(websocket_subprotocol(websocket))
         raw_send = websocket.scope.get("fsmscope.raw_send") or websocket._send
 
         async def send(frame: str) -> None:
@@ -278,7 +276,8 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
         if refusal is not None:
             await deny_websocket(websocket, *refusal)
             return
-        await websocket.accept()
+        await websocket.accept(websocket_subprotocol(websocket))
+        fed: set[str] = set()  # the machines this publisher feeds: shown disconnected when it leaves
         try:
             while True:
                 message = await websocket.receive()
@@ -298,21 +297,35 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
                     await websocket.close(1007, "frames must be JSON arrays of events")
                     return
                 for event in events:
-                    if _valid_event(event):
-                        try:
-                            hub.ingest(event)
-                        except (KeyError, TypeError, ValueError, AttributeError):
-                            pass  # a malformed event from a publisher: skipped
+                    problem = hub.ingest(event)
+                    if problem is None:
+                        fed.add(event["machine"])
+                        hub.get(event["machine"]).connected = True
+                        continue
+                    await websocket.send_text(orjson.dumps(
+                        {"type": "rejected", "reason": problem, "machine": _field(event, "machine"),
+                         "seq": _field(event, "seq")}).decode())
         except WebSocketDisconnect:
             return
+        finally:
+            for name in fed:
+                entry = hub.get(name)
+                if entry is not None and entry.source == "ingest":
+                    entry.connected = False
 
     root = static_dir()
     if root and os.path.isdir(root):
         app.mount("/static", StaticFiles(directory=root), name="static")
         app.mount("/", StaticFiles(directory=root), name="static-root")
-
-    app.add_middleware(SecurityMiddleware, settings=settings)
     return app
+
+
+class _App(FastAPI):
+    """FastAPI with the security middleware outside everything, even the handler that answers
+    500: every response, errors included, goes through the Host check and gets its headers."""
+
+    def build_middleware_stack(self) -> Any:
+        return SecurityMiddleware(super().build_middleware_stack(), self.state.settings)
 
 
 async def _drain_incoming(websocket: WebSocket) -> None:
@@ -323,27 +336,7 @@ async def _drain_incoming(websocket: WebSocket) -> None:
             return
 
 
-def _valid_event(event: Any) -> bool:
-    if not isinstance(event, dict) or event.get("v") != 1:
-        return False
-    if not isinstance(event.get("machine"), str) or not event["machine"] or len(event["machine"]) > 200:
-        return False
-    if type(event.get("seq")) is not int or not isinstance(event.get("kind"), str):
-        return False
-    if not isinstance(event.get("path"), str):
-        return False
-    kind = event["kind"]
-    if kind == "structure":
-        return isinstance(event.get("root"), dict) and isinstance(event["root"].get("path"), str)
-    if kind == "snapshot":
-        return isinstance(event.get("status"), dict)
-    if kind == "start":
-        return isinstance(event.get("active"), list) and isinstance(event.get("initial"), list) and \
-            isinstance(event.get("userdata"), dict)
-    if kind == "transition":
-        return isinstance(event.get("active"), list)
-    if kind == "userdata":
-        return isinstance(event.get("changes"), dict)
-    if kind == "terminate":
-        return "outcome" in event
-    return True
+def _field(event: Any, name: str) -> Any:
+    """A refused event's field, echoed back to its publisher only when it is a plain scalar."""
+    value = event.get(name) if isinstance(event, dict) else None
+    return value if type(value) in (str, int) else None

@@ -27,7 +27,7 @@ import threading
 import time
 from typing import Any, Callable
 
-from fsm import introspection
+from fsm import introspection, schema
 from fsm.encoding import dumps
 from fsm.status import Status
 
@@ -116,6 +116,8 @@ class MachineEntry:
         self.loop_seq = 0  # the seq of the newest event the loop has taken (the ring's end, gaps or not)
         self.clients: set[Client] = set()
         self.idle: set[Client] = set()  # clients whose sender waits for the next event
+        self.rejected = 0  # events refused at the door (ingest) for not fitting the schema
+        self.connected: bool | None = None  # ingest: whether its publisher is connected (None: not ingested)
         self.handle: Any = None  # server.control.MachineHandle for local machines
         self.reporter: introspection.Reporter | None = None
         self._structure_id: int | None = None
@@ -155,9 +157,10 @@ class MachineEntry:
         return key[1], frame
 
     def running(self) -> bool:
+        """Running as far as anyone can tell: a machine whose publisher left is not shown running."""
         if self.handle is not None:
             return self.handle.is_running()
-        return self.status.running
+        return self.status.running and self.connected is not False
 
     def encoded_from(self, seq: int, limit: int) -> list[bytes] | None:
         """Up to ``limit`` encoded events from ``seq`` on; None when ``seq`` is no longer kept."""
@@ -253,6 +256,7 @@ class Hub:
         self._scheduled = False
         self._watchdog: asyncio.Task | None = None
         self._hook: Callable | None = None
+        self.rejected = 0  # refused events that named no known machine
         self.scene_url: str | None = None  # a 3D view served beside the dashboard (the sim demo's viser)
 
     # Lifecycle (the app's lifespan calls these on the loop).
@@ -306,8 +310,8 @@ class Hub:
         entry = MachineEntry(self, rep.machine, "local")
         entry.reporter = rep
         entry.handle = MachineHandle(machine, rep, can_start, starter)
-        entry.status.apply({"seq": rep.last_seq, "kind": "structure", "path": rep.root_path, "run": rep.run,
-                            "root": rep.structure()})
+        entry.status.apply(schema.event(rep.last_seq, time.time(), rep.run, rep.machine, "structure", rep.root_path,
+                                        {"root": rep.structure()}))
         entry.loop_seq = rep.last_seq
         incoming = self._incoming
         schedule = self._schedule
@@ -368,9 +372,18 @@ class Hub:
             self._drain()
 
     # Ingest (on the loop).
-    def ingest(self, event: dict, source: str = "ingest") -> str | None:
-        """Apply one event from another process (or, ``source="replay"``, from a log); returns an
-        error text for a refused event."""
+    def ingest(self, event: Any, source: str = "ingest") -> str | None:
+        """Apply one event from another process (or, ``source="replay"``, from a log); returns why
+        an event was refused. An event that does not fit the schema never reaches the Status."""
+        problem = schema.validate(event)
+        if problem:
+            name = event.get("machine") if type(event) is dict else None
+            entry = self._machines.get(name) if type(name) is str else None
+            if entry is not None:
+                entry.rejected += 1
+            else:
+                self.rejected += 1
+            return problem
         name = event["machine"]
         with self._lock:
             entry = self._machines.get(name)

@@ -6,6 +6,8 @@ from typing import Any, Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from fsm.schema import SOURCES
+
 JsonValue = Any
 
 
@@ -29,7 +31,10 @@ class MachineInfo(BaseModel):
     last_seq: int
     root_path: Optional[str] = None
     can_start: bool
-    source: Literal["local", "ingest", "replay"]
+    source: Literal[SOURCES]  # type: ignore[valid-type]
+    connected: Optional[bool] = Field(default=None, description="a machine of another process: whether its "
+                                      "publisher is connected (null for the others)")
+    rejected: int = Field(default=0, description="events refused at the door for not fitting the schema")
 
 
 class Transition(BaseModel):

@@ -9,17 +9,28 @@ them in batches over the authenticated websocket ``/api/ingest``. When the serve
 the machine runs on: events keep being folded into the Status, and on reconnecting (with
 backoff) the publisher first sends a ``snapshot`` event of each machine, then new events.
 
+The server checks every event against the schema (``fsm.schema``) and answers a refused one
+with a ``rejected`` frame; the publisher counts those (``rejected``) and says why on stderr.
+At exit the publisher sends what it still holds (``close()`` runs from ``atexit``), so a
+script that ends right after its machine does not leave the dashboard showing it running;
+``with Publisher(url, token) as pub:`` closes it at the end of the block.
+
 Imports only the standard library, ``websockets`` and ``fsm`` (no FastAPI).
 """
 
 from __future__ import annotations
 
+import atexit
 import collections
+import sys
 import threading
 import time
 import urllib.parse
+import weakref
+from typing import Any
 
-from fsm.encoding import dumps
+from fsm import schema
+from fsm.encoding import dumps, loads
 from fsm.status import Status
 
 BUFFER = 100_000      # events held for the sender before the oldest are dropped
@@ -54,7 +65,9 @@ class Publisher:
         self.sent = 0
         self.connects = 0
         self.dropped = 0
+        self.rejected = 0  # events the server refused (see stderr for why)
         self._thread: threading.Thread | None = None
+        _open_publishers.add(self)
         if start:
             self.start()
 
@@ -74,14 +87,15 @@ class Publisher:
         return self
 
     def close(self, timeout: float = 5.0) -> None:
-        """Send what is buffered (if connected), then stop."""
+        """Send what is buffered (while connected), then stop. Idempotent."""
         deadline = time.monotonic() + timeout
-        while self._buf and self.connected.is_set() and time.monotonic() < deadline:
-            time.sleep(0.01)
+        if self.connected.is_set():
+            self.flush(timeout)
         self._stop.set()
         self._wake.set()
-        if self._thread is not None:
+        if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(max(0.1, deadline - time.monotonic()))
+        _open_publishers.discard(self)
 
     def flush(self, timeout: float = 5.0) -> bool:
         """Wait until every buffered event was handed to the socket; False on timeout."""
@@ -89,6 +103,12 @@ class Publisher:
         while (self._buf or self._busy) and time.monotonic() < deadline:
             time.sleep(0.005)
         return not self._buf
+
+    def __enter__(self) -> Publisher:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
 
     _busy = False
 
@@ -106,12 +126,21 @@ class Publisher:
         return batch
 
     def _snapshots(self) -> list[dict]:
-        out = []
-        for name, status in self._statuses.items():
-            if status.last_seq:
-                out.append({"v": 1, "seq": status.last_seq, "t": time.time(), "run": status.run, "machine": name,
-                            "kind": "snapshot", "path": status.root_path or "/SM_ROOT", "status": status.to_dict()})
-        return out
+        return [schema.event(status.last_seq, time.time(), status.run, name, "snapshot",
+                             status.root_path or "/SM_ROOT", {"status": status.to_dict()})
+                for name, status in self._statuses.items() if status.last_seq]
+
+    def _read_answers(self, ws: Any) -> None:
+        """Count the server's ``rejected`` frames (it sends nothing else) without waiting."""
+        while True:
+            try:
+                frame = loads(ws.recv(timeout=0))
+            except TimeoutError:
+                return
+            if type(frame) is dict and frame.get("type") == "rejected":
+                self.rejected += 1
+                sys.stderr.write("fsmscope publisher: the server refused event %s of %s: %s\n"
+                                 % (frame.get("seq"), frame.get("machine"), frame.get("reason")))
 
     def _run(self) -> None:
         from websockets.sync.client import connect
@@ -140,6 +169,7 @@ class Publisher:
                             ws.send(dumps(batch).decode())
                             self.sent += len(batch)
                             continue
+                        self._read_answers(ws)
                         self._busy = False
                         self._wake.clear()
                         if not self._buf:
@@ -154,3 +184,16 @@ class Publisher:
     def _take_all(self) -> None:
         while self._buf:
             self._take()
+
+
+_open_publishers: weakref.WeakSet[Publisher] = weakref.WeakSet()
+
+
+@atexit.register
+def _close_all() -> None:
+    """A script that exits without closing its publisher still sends its last events."""
+    for publisher in list(_open_publishers):
+        try:
+            publisher.close()
+        except Exception:
+            pass

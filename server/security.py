@@ -1,9 +1,15 @@
-"""Token, cookie exchange, Host and Origin checks, and the request body limit.
+"""Token, Host and Origin checks, and the request body limit.
 
 ``SecurityMiddleware`` is pure ASGI and outermost: it answers 400 for a foreign ``Host``
-(DNS rebinding) and 413 for a body over the limit before any route runs, and keeps the
-server's raw ``send`` in the scope so a stalled websocket can be aborted. Route-level checks
-(token, Origin) are the dependencies and helpers below.
+(DNS rebinding) and 413 for a body over the limit before any route runs, adds the hardening
+headers to every HTTP response (errors included), and keeps the server's raw ``send`` in the
+scope so a stalled websocket can be aborted. Route-level checks (token, Origin) are the
+dependencies and helpers below.
+
+The token travels only where the page puts it: an ``Authorization: Bearer`` header, a
+websocket subprotocol ``fsmscope.token.TOKEN`` (browsers cannot set headers on a websocket),
+or ``?token=`` for scripts. There is no cookie: cookies are not port-scoped, so one would be
+sent to every other server on the host, and a second dashboard's would replace the first's.
 """
 
 from __future__ import annotations
@@ -15,9 +21,9 @@ from typing import Any
 
 from fastapi import HTTPException, Request, WebSocket
 
-COOKIE = "fsmscope_token"
 MAX_BODY = 64 * 1024
-LOOPBACK_NAMES = ("127.0.0.1", "localhost", "::1", "[::1]")
+SUBPROTOCOL = "fsmscope"  # the websocket subprotocol the server answers with
+TOKEN_SUBPROTOCOL = "fsmscope.token."  # followed by the token: how a browser's websocket carries it
 
 
 def new_token() -> str:
@@ -117,6 +123,8 @@ class SecurityMiddleware:
             await self.app(scope, receive, send)
             return
         headers = {k.decode("latin-1").lower(): v.decode("latin-1") for k, v in scope.get("headers", ())}
+        if kind == "http":
+            send = _hardened(send)
         if not self.settings.host_ok(headers.get("host")):
             if kind == "http":
                 await _json(send, 400, "invalid Host header")
@@ -127,7 +135,6 @@ class SecurityMiddleware:
             scope["fsmscope.raw_send"] = send
             await self.app(scope, receive, send)
             return
-        send = _hardened(send)
         if scope["method"] in ("POST", "PUT", "PATCH", "DELETE"):
             limit = self.settings.max_body
             length = headers.get("content-length")
@@ -208,35 +215,32 @@ async def deny_websocket(websocket: WebSocket, status: int, detail: str) -> None
 
 # Route checks.
 
-def request_token(request: Request) -> tuple[str | None, str]:
-    """The token a request carries and how: 'bearer', 'query' or 'cookie'."""
-    token = _bearer(request.headers)
-    if token:
-        return token, "bearer"
-    token = request.query_params.get("token")
-    if token:
-        return token, "query"
-    return request.cookies.get(COOKIE), "cookie"
-
-
 def require_token(request: Request) -> None:
-    """Dependency for everything under /api but health: 401 without a valid token; cookie-only POSTs
-    must also come from our own origin with a JSON body."""
+    """Dependency for everything under /api but health: 403 for a state change from another
+    origin, 401 without a valid token (Authorization: Bearer or ?token=)."""
     settings: Settings = request.app.state.settings
     origin = request.headers.get("origin")
     if request.method != "GET" and origin is not None and origin != own_origin(request.headers.get("host")):
         raise HTTPException(403, "cross-origin request refused")
-    if not settings.token:
-        return
-    token, how = request_token(request)
-    if not settings.token_ok(token):
-        raise HTTPException(401, "a valid token is required (Authorization: Bearer, ?token= or the cookie)")
-    if how == "cookie" and request.method != "GET":
-        if origin is None or origin != own_origin(request.headers.get("host")):
-            raise HTTPException(403, "a cookie-authenticated request must come from the dashboard's origin")
-        ctype = request.headers.get("content-type", "").split(";")[0].strip().lower()
-        if ctype != "application/json":
-            raise HTTPException(403, "a cookie-authenticated request must send a JSON body")
+    if not settings.token_ok(_bearer(request.headers) or request.query_params.get("token")):
+        raise HTTPException(401, "a valid token is required (Authorization: Bearer or ?token=)")
+
+
+def websocket_token(websocket: WebSocket) -> str | None:
+    """The token a websocket carries: its subprotocol, a Bearer header, or ?token=."""
+    offered = websocket.headers.get("sec-websocket-protocol", "")
+    for protocol in offered.split(","):
+        protocol = protocol.strip()
+        if protocol.startswith(TOKEN_SUBPROTOCOL):
+            return protocol[len(TOKEN_SUBPROTOCOL):]
+    return _bearer(websocket.headers) or websocket.query_params.get("token")
+
+
+def websocket_subprotocol(websocket: WebSocket) -> str | None:
+    """The subprotocol to accept with: ours when the client offered it (a browser must be answered
+    with one it offered), else none."""
+    offered = [p.strip() for p in websocket.headers.get("sec-websocket-protocol", "").split(",")]
+    return SUBPROTOCOL if SUBPROTOCOL in offered else None
 
 
 def websocket_refusal(websocket: WebSocket) -> tuple[int, str] | None:
@@ -245,9 +249,6 @@ def websocket_refusal(websocket: WebSocket) -> tuple[int, str] | None:
     origin = websocket.headers.get("origin")
     if origin is not None and origin != own_origin(websocket.headers.get("host")):
         return 403, "websocket from a foreign origin refused"
-    if not settings.token:
-        return None
-    token = _bearer(websocket.headers) or websocket.query_params.get("token") or websocket.cookies.get(COOKIE)
-    if not settings.token_ok(token):
+    if not settings.token_ok(websocket_token(websocket)):
         return 401, "a valid token is required"
     return None

@@ -1,5 +1,7 @@
-// Fetch wrappers for the REST API (docs/api.md). Same origin, the HttpOnly cookie authenticates;
-// JSON bodies; every failure becomes an ApiError carrying the server's `detail`.
+// Fetch wrappers for the REST API (docs/api.md). Same origin, the page's token authenticates
+// (token.js); JSON bodies; every failure becomes an ApiError carrying the server's `detail`.
+
+import { authHeaders } from "./token.js";
 
 export class ApiError extends Error {
   constructor(status, detail) {
@@ -10,7 +12,7 @@ export class ApiError extends Error {
 }
 
 async function request(method, url, body, accept = "json") {
-  const init = { method, credentials: "same-origin", cache: "no-store", headers: {} };
+  const init = { method, credentials: "omit", cache: "no-store", headers: authHeaders() };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);

@@ -1,6 +1,8 @@
 // One machine's websocket stream (docs/api.md): snapshot / events / missed frames, reconnect
 // with backoff resuming from the last seq seen, and the numbers the connection badge shows.
 
+import { streamProtocols } from "./token.js";
+
 const RATE_WINDOW_MS = 3000;
 const BACKOFF_MIN_MS = 250;
 const BACKOFF_MAX_MS = 4000;
@@ -62,7 +64,7 @@ export class Stream {
   _open(since) {
     if (this.stopped) return;
     this._setState(this.connects ? "reconnecting" : "connecting");
-    const ws = new WebSocket(this.options.url(this.name, since));
+    const ws = new WebSocket(this.options.url(this.name, since), streamProtocols());
     this.ws = ws;
     ws.onopen = () => {
       this.failures = 0;

@@ -53,7 +53,7 @@ def test_a_json_line_that_is_not_an_event_is_reported(log):
     with open(log, "ab") as handle:
         handle.write(b'[1, 2]\n{"v": 1, "seq": 9}\n')
     _, problems = _read(log)
-    assert [p.message for p in problems] == ["not a JSON object", "event lacks 'machine'"]
+    assert [p.message for p in problems] == ["not a JSON object", "invalid event: event lacks 't'"]
 
 
 def test_an_unknown_schema_version_is_refused_with_a_clear_message(log):

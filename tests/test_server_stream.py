@@ -61,6 +61,23 @@ def test_stream_without_token_is_refused_401(live_server):
     assert info.value.response.status_code == 401
 
 
+def test_stream_authenticates_with_the_token_as_a_subprotocol_and_answers_with_its_own(live_server):
+    live_server.hub.add_local(two_state_machine(), name="two")
+    url = "ws://127.0.0.1:%d/api/machines/two/stream" % live_server.port
+    with connect(url, subprotocols=["fsmscope", "fsmscope.token." + live_server.token], open_timeout=5) as ws:
+        assert ws.subprotocol == "fsmscope"
+        [snap] = frames(ws, lambda got: len(got) == 1)
+    assert snap["type"] == "snapshot"
+
+
+def test_stream_with_a_wrong_token_subprotocol_is_refused_401(live_server):
+    live_server.hub.add_local(two_state_machine(), name="two")
+    url = "ws://127.0.0.1:%d/api/machines/two/stream" % live_server.port
+    with pytest.raises(InvalidStatus) as info:
+        connect(url, subprotocols=["fsmscope", "fsmscope.token.wrong"], open_timeout=5)
+    assert info.value.response.status_code == 401
+
+
 def test_stream_from_a_foreign_origin_is_refused_403(live_server):
     live_server.hub.add_local(two_state_machine(), name="two")
     with pytest.raises(InvalidStatus) as info:

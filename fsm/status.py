@@ -55,10 +55,12 @@ class Status:
             entry = self.containers[path] = _container_entry()
         root = path == self.root_path
         if kind == "start":
+            if root:  # a new run: what the previous one reached no longer describes the machine
+                self.running, self.outcome, self.error = True, None, None
+                for other in self.containers.values():
+                    other.update(active=[], running=False, outcome=None)
             entry.update(active=list(event["active"]), initial=list(event["initial"]),
                          userdata=dict(event["userdata"]), running=True, outcome=None)
-            if root:
-                self.running, self.outcome, self.error = True, None, None
         elif kind == "transition":
             entry["active"] = event["active"]  # events are never changed once emitted: no copy
         elif kind == "userdata":

@@ -145,9 +145,7 @@ function openMachine(name) {
   app.nodes = new Map();
   app.structureKey = null;
   app.selected = null;
-  app.changed = new Map();
-  app.pendingChanges = new Map();
-  app.lastEdge = new Map();
+  forgetRunMarks();
   app.expand = null;
   // Notices and preempt bookkeeping are about the machine shown so far, not this one.
   clearNotice();
@@ -180,9 +178,7 @@ function openMachine(name) {
 
 function onSnapshot(status) {
   app.status = Status.fromDict({ machine: app.name, ...status });
-  app.changed = new Map();
-  app.pendingChanges = new Map();
-  app.lastEdge = new Map();
+  forgetRunMarks();
   structureChanged();
   queueRender();
 }
@@ -199,14 +195,24 @@ function onEvents(events) {
   queueRender();
 }
 
+/** Forget the last edges and changed keys seen so far (the reducer keeps neither). */
+function forgetRunMarks() {
+  app.changed = new Map();
+  app.pendingChanges = new Map();
+  app.lastEdge = new Map();
+}
+
 /** What the reducer does not keep but the page shows: last edges, changed keys, outcomes. */
 function track(ev) {
   const path = ev.path;
   switch (ev.kind) {
     case "start":
-      if (path === app.status.root_path && app.finishedText) {
-        app.finishedText = null;
-        clearNotice(); // the previous run's outcome no longer describes the machine
+      if (path === app.status.root_path) {
+        forgetRunMarks(); // a new run: the page shows this run only, as the reducer does
+        if (app.finishedText) {
+          app.finishedText = null;
+          clearNotice(); // the previous run's outcome no longer describes the machine
+        }
       }
       app.pendingChanges.set(path, new Set());
       app.changed.set(path, new Set());

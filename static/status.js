@@ -61,15 +61,18 @@ export class Status {
     if (entry === undefined) entry = this.containers[path] = containerEntry();
     const root = path === this.root_path;
     if (kind === "start") {
+      if (root) { // a new run: what the previous one reached no longer describes the machine
+        this.running = true;
+        this.outcome = null;
+        this.error = null;
+        for (const other of Object.values(this.containers)) {
+          Object.assign(other, { active: [], running: false, outcome: null });
+        }
+      }
       Object.assign(entry, {
         active: [...event.active], initial: [...event.initial],
         userdata: { ...event.userdata }, running: true, outcome: null,
       });
-      if (root) {
-        this.running = true;
-        this.outcome = null;
-        this.error = null;
-      }
     } else if (kind === "transition") {
       entry.active = [...event.active];
     } else if (kind === "userdata") {

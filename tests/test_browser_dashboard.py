@@ -303,7 +303,7 @@ def test_page_recovers_when_the_server_restarts(page, server):
 
 
 def test_js_reducer_matches_python(page):
-    """fsm.status.Status and static/status.js rebuild the same state from the same events."""
+    """fsm.status.Status and static/status.js rebuild the same state from the same events, over two runs."""
     import fsm
     from fsm.status import rebuild
 
@@ -312,21 +312,30 @@ def test_js_reducer_matches_python(page):
     fsm.set_loggers(*(lambda msg: None,) * 4)
     sm = build_machine()
     events: list[dict] = []
-    lap = threading.Event()
+    lap, second_run_moved = threading.Event(), threading.Event()
 
     def observe(event):
         events.append(event)
-        if event["kind"] == "transition" and event.get("to") == "COUNT":
+        moved_to = event.get("to") if event["kind"] == "transition" else None
+        if moved_to == "COUNT":
             lap.set()
+        elif moved_to == "NESTED" and event["run"] != events[0]["run"]:
+            second_run_moved.set()
+
+    def run_until(mark):
+        runner = threading.Thread(target=sm.execute)
+        runner.start()
+        try:
+            assert mark.wait(10)
+        finally:
+            sm.request_preempt()  # from another thread, as the server does
+            runner.join(10)
 
     reporter = fsm.attach(sm, observe, name="lap")
-    runner = threading.Thread(target=sm.execute)
-    runner.start()
     try:
-        assert lap.wait(10)
+        run_until(lap)  # the first run goes through every container
+        run_until(second_run_moved)  # the second is preempted in NESTED: PAR does not run again
     finally:
-        sm.request_preempt()  # from another thread, as the server does
-        runner.join(10)
         reporter.remove_observer(observe)  # leave no log listener behind for other tests
     want = rebuild(events)["lap"].to_dict()
     got = page.evaluate("""async (events) => {
@@ -337,6 +346,7 @@ def test_js_reducer_matches_python(page):
     }""", json.loads(json.dumps(events)))
     assert got == json.loads(json.dumps(want))
     assert got["outcome"] == "preempted"
+    assert got["containers"]["/SM_ROOT/PAR"]["outcome"] is None  # what it reached in the first run is gone
 
 
 if __name__ == "__main__" and sys.argv[1:2] == ["--serve"]:

@@ -25,6 +25,8 @@ from typing import Iterable
 
 import pydot
 
+from fsm.schema import container_id, edge_id, outcome_id, state_id
+
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
 ET.register_namespace("", SVG_NS)
@@ -41,9 +43,15 @@ class GraphError(Exception):
     """Graphviz failed or is missing."""
 
 
+# XML cannot hold control characters (Graphviz would write them raw): a label shows each as its
+# Unicode "control picture" (U+2400 + code), ids are percent-escaped by fsm.schema.
+_VISIBLE = {c: 0x2400 + c for c in range(0x20)}
+_VISIBLE.update({0x7F: 0x2421, 0xFFFE: 0xFFFD, 0xFFFF: 0xFFFD})
+
+
 def q(text: str) -> str:
     """A DOT double-quoted string: never an HTML label, no escape sequences of dot's own."""
-    return '"%s"' % str(text).replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n")
+    return '"%s"' % str(text).translate(_VISIBLE).replace("\\", "\\\\").replace('"', '\\"')
 
 
 def containers(node: dict) -> Iterable[dict]:
@@ -79,7 +87,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
     """One container's graph; ``sizes`` gives the drawing size (points) of each open child container."""
     path = node["path"]
     g = pydot.Dot(q(path), graph_type="digraph")
-    g.set("id", q("c:" + path))
+    g.set("id", q(container_id(path)))
     g.set("label", q(node["label"] + " (" + node.get("type", "") + ")"))
     g.set("labelloc", "t")
     g.set("fontsize", "12")
@@ -97,20 +105,20 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
         cpath = child["path"]
         if cpath in sizes:
             w, h = sizes[cpath]
-            g.add_node(pydot.Node(name, id=q("s:" + cpath), label=q(""), shape="box", style="solid", color="transparent",
+            g.add_node(pydot.Node(name, id=q(state_id(cpath)), label=q(""), shape="box", style="solid", color="transparent",
                                   fixedsize="true", width="%.4f" % (w / 72.0), height="%.4f" % (h / 72.0)))
         elif child.get("container"):
-            g.add_node(pydot.Node(name, id=q("s:" + cpath), label=q(child["label"]), shape="box3d", style="solid",
+            g.add_node(pydot.Node(name, id=q(state_id(cpath)), label=q(child["label"]), shape="box3d", style="solid",
                                   **{"class": q("container")}))
         else:
-            g.add_node(pydot.Node(name, id=q("s:" + cpath), label=q(child["label"]), **{"class": q("state")}))
+            g.add_node(pydot.Node(name, id=q(state_id(cpath)), label=q(child["label"]), **{"class": q("state")}))
     outcome_nodes: dict[str, str] = {}
 
     def outcome_node(outcome: str) -> str:
         name = outcome_nodes.get(outcome)
         if name is None:
             name = outcome_nodes[outcome] = "o%d" % len(outcome_nodes)
-            g.add_node(pydot.Node(name, id=q("o:%s:%s" % (path, outcome)), label=q(outcome), shape="ellipse",
+            g.add_node(pydot.Node(name, id=q(outcome_id(path, outcome)), label=q(outcome), shape="ellipse",
                                   style="filled", fillcolor="lightgrey", **{"class": q("outcome")}))
         return name
 
@@ -129,12 +137,12 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
         if dst is None:
             dst = outcome_node(target)
             outcome_set.add(dst)
-        edge_id = "e:%s:%s:%s" % (path, tr["from"], tr["outcome"])
-        n = seen.get(edge_id, 0)
-        seen[edge_id] = n + 1
+        eid = edge_id(path, tr["from"], tr["outcome"])
+        n = seen.get(eid, 0)
+        seen[eid] = n + 1
         if n:
-            edge_id += ":%d" % (n + 1)
-        attrs = {"id": q(edge_id), ("xlabel" if big else "label"): q(tr["outcome"])}
+            eid += ":%d" % (n + 1)
+        attrs = {"id": q(eid), ("xlabel" if big else "label"): q(tr["outcome"])}
         if dst in outcome_set:  # edges into outcomes do not rank: many long edges to one sink explode dot
             attrs["constraint"] = "false"
         g.add_edge(pydot.Edge(src, dst, **attrs))
@@ -278,14 +286,15 @@ class Renderer:
         if frame is not None:
             frame.set("class", "frame")
             frame.set("stroke", "#999999")
+        placeholders = {state_id(c["path"]): c["path"] for c in node.get("children") or () if c["path"] in done}
         for i, child in enumerate(list(group)):
-            cid = child.get("id", "")
-            if child.tag != _G or not cid.startswith("s:") or cid[2:] not in done:
+            cpath = placeholders.get(child.get("id", ""))
+            if child.tag != _G or cpath is None:
                 continue
             corner = _bbox(child)
             if corner is None:
                 continue
-            inner = done[cid[2:]][0]
+            inner = done[cpath][0]
             wrapper = ET.Element(_G, {"transform": "translate(%g %g)" % corner})
             wrapper.append(inner)
             group[i] = wrapper

@@ -87,10 +87,10 @@ class Publisher:
         return self
 
     def close(self, timeout: float = 5.0) -> None:
-        """Send what is buffered (while connected), then stop. Idempotent."""
+        """Send what is buffered (waiting up to ``timeout`` for a connection), then stop. Idempotent."""
         deadline = time.monotonic() + timeout
-        if self.connected.is_set():
-            self.flush(timeout)
+        if self._buf and not self._stop.is_set() and self.connected.wait(timeout):
+            self.flush(max(0.0, deadline - time.monotonic()))
         self._stop.set()
         self._wake.set()
         if self._thread is not None and self._thread is not threading.current_thread():

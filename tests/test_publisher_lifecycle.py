@@ -1,0 +1,63 @@
+"""A machine published from another process (README's `smach.attach(sm, Publisher(url, token))`):
+its last events arrive even when the script exits at once, and a publisher that goes away in the
+middle of a run shows its machine disconnected, not running."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+
+from browser_support import ROOT
+from server_support import client, wait_for
+
+SCRIPT = textwrap.dedent("""
+    import sys, time
+    import fsm as smach
+    from server.publisher import Publisher
+
+    def step(ud):
+        time.sleep(float(sys.argv[3]))
+        return "go"
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        smach.StateMachine.add("A", smach.CBState(step, outcomes=["go"]), {"go": "B"})
+        smach.StateMachine.add("B", smach.CBState(step, outcomes=["go"]), {"go": "done"})
+    smach.attach(sm, Publisher(sys.argv[1], sys.argv[2]), name="remote")
+    print("started", file=sys.stderr, flush=True)
+    sm.execute()
+""")
+
+
+def publish(tmp_path, srv, step_seconds: float) -> subprocess.Popen:
+    script = tmp_path / "publish.py"
+    script.write_text(SCRIPT)
+    return subprocess.Popen([sys.executable, str(script), srv.base_url, srv.token, str(step_seconds)], cwd=ROOT,
+                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)))
+
+
+def remote(srv) -> dict | None:
+    return next((m for m in client(srv).get("/api/machines").json() if m["name"] == "remote"), None)
+
+
+def test_a_script_that_exits_right_after_its_run_delivers_the_last_events(live_server, tmp_path):
+    proc = publish(tmp_path, live_server, 0.0)
+    assert proc.wait(30) == 0
+    wait_for(lambda: remote(live_server) is not None and remote(live_server)["outcome"] == "done", timeout=5)
+    assert remote(live_server)["running"] is False
+
+
+def test_a_publisher_killed_mid_run_shows_its_machine_disconnected_not_running(live_server, tmp_path):
+    proc = publish(tmp_path, live_server, 30.0)
+    try:
+        assert proc.stderr.readline().strip() == "started"
+        wait_for(lambda: remote(live_server) is not None and remote(live_server)["running"], timeout=10)
+    finally:
+        proc.send_signal(signal.SIGKILL)
+        proc.wait(10)
+    wait_for(lambda: remote(live_server)["connected"] is False, timeout=10)
+    info = remote(live_server)
+    assert info["running"] is False and info["outcome"] is None

@@ -1,0 +1,110 @@
+"""fsm.schema: every event the runtime emits fits it; what does not fit is refused in words."""
+
+from __future__ import annotations
+
+import glob
+import os
+
+import fsm
+import pytest
+from fsm import schema
+from fsm.log_reader import read_events
+
+from event_support import deep_root, ev, flat_root, run_of
+from server_support import nested_machine, two_state_machine
+
+
+def test_every_event_of_an_observed_run_fits_the_schema():
+    events = []
+    for sm in (two_state_machine(), nested_machine()):
+        fsm.attach(sm, events.append)
+        sm.execute()
+    assert events and [schema.validate(e) for e in events] == [None] * len(events)
+
+
+def test_every_event_of_the_examples_fits_the_schema(tmp_path):
+    from server.runner import Runner
+
+    for script in sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "examples", "*.py"))):
+        log = tmp_path / (os.path.basename(script) + ".jsonl")
+        Runner(script, [], str(log)).run()
+        problems = []
+        events = list(read_events(log, on_problem=problems.append))
+        assert events and not problems, (script, problems[:3])
+
+
+def test_a_snapshot_of_a_recorded_run_fits_the_schema(tmp_path):
+    sm = two_state_machine()
+    with fsm.Recorder(tmp_path / "run.jsonl", snapshot_every=2) as recorder:
+        fsm.attach(sm, recorder, name="two")
+        sm.execute()
+    snapshots = [e for e in read_events(tmp_path / "run.jsonl") if e["kind"] == "snapshot"]
+    assert snapshots and all(schema.validate(e) is None for e in snapshots)
+
+
+def test_a_terminate_whose_outcome_is_a_number_is_refused_in_words():
+    bad = ev(3, "terminate", last=["A"], outcome=5)
+    assert schema.validate(bad) == "terminate.outcome must be a string or null, not an integer"
+
+
+def test_a_time_that_is_not_a_number_is_refused():
+    bad = ev(3, "log", level="info", msg="hi")
+    bad["t"] = "yesterday"
+    assert schema.validate(bad) == "event.t must be a finite number, not a string"
+
+
+def test_a_transition_without_from_is_refused():
+    bad = ev(3, "transition", outcome="go", to="B", active=["B"])
+    assert schema.validate(bad) == "transition lacks 'from'"
+
+
+def test_an_unknown_kind_is_refused():
+    assert schema.validate(ev(3, "teleport")) == "unknown kind 'teleport'"
+
+
+def test_a_structure_whose_child_path_does_not_follow_its_label_is_refused():
+    root = flat_root("A")
+    root["children"][0]["path"] = "/ELSEWHERE/A"
+    problem = schema.validate(ev(1, "structure", root=root))
+    assert "should be '/SM_ROOT/A'" in problem
+
+
+def test_a_structure_deeper_than_the_limit_is_refused():
+    problem = schema.validate(ev(1, "structure", root=deep_root(200)))
+    assert problem == "structure.root the structure is deeper than %d levels" % schema.MAX_STRUCTURE_DEPTH
+
+
+def test_a_structure_within_the_depth_limit_fits():
+    assert schema.validate(ev(1, "structure", root=deep_root(schema.MAX_STRUCTURE_DEPTH - 1))) is None
+
+
+def test_a_nested_snapshot_problem_names_where_it_is():
+    status = {"containers": {"/SM_ROOT": {"active": [7], "initial": [], "userdata": {}, "running": True,
+                                          "outcome": None}}, "running": True, "outcome": None}
+    assert schema.validate(ev(4, "snapshot", status=status)) == \
+        "snapshot.status.containers['/SM_ROOT'].active[0] must be a string, not an integer"
+
+
+def test_a_userdata_value_nested_past_the_limit_is_refused():
+    value: list = []
+    for _ in range(schema.MAX_VALUE_DEPTH + 2):
+        value = [value]
+    assert "nested deeper" in schema.validate(ev(3, "userdata", changes={"k": value}))
+
+
+def test_a_sequence_number_beyond_what_a_browser_holds_exactly_is_refused():
+    bad = ev(3, "log", level="info", msg="hi")
+    bad["seq"] = 2 ** 53
+    assert schema.validate(bad).startswith("event.seq must be an integer from 0 to 2^53-1")
+
+
+@pytest.mark.parametrize("event", run_of(flat_root("A", "B")), ids=lambda e: e["kind"])
+def test_the_test_support_run_is_valid(event):
+    assert schema.validate(event) is None
+
+
+def test_graph_ids_escape_control_characters_and_percent_one_to_one():
+    assert schema.state_id("/SM_ROOT/VT\x0bBAD") == "s:/SM_ROOT/VT%0BBAD"
+    assert schema.state_id("/SM_ROOT/100%") == "s:/SM_ROOT/100%25"
+    assert schema.edge_id("/R", "A\n", "go") == "e:/R:A%0A:go"
+    assert schema.state_id("/SM_ROOT/VT%0BBAD") != schema.state_id("/SM_ROOT/VT\x0bBAD")

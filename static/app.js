@@ -23,6 +23,7 @@ const app = {
   pendingChanges: new Map(), // container path -> Set of keys written since its last transition
   lastEdge: new Map(), // container path -> e: id of its last transition
   expand: null, // null: the server's default; else a Set of container paths drawn open
+  endings: new Map(), // name -> {seq, error} of the other machines that ended without an outcome
   preemptAsked: false,
   preemptAck: null,
   finishedText: null, // "NAME finished: outcome 'X'" once the root terminated, until it starts again
@@ -95,6 +96,7 @@ async function pollMachines() {
     app.online = true;
     banner("");
     app.machines = Array.isArray(list) ? list : [];
+    checkEndings();
     fillPicker();
     if (!scene.url) api.scene().then((s) => scene.show(s && s.url)).catch(() => {});
     if (!app.name || !app.machines.some((m) => m.name === app.name)) {
@@ -116,13 +118,37 @@ async function pollMachines() {
   }
 }
 
+/** running, done (reached an outcome), failed (ended without one after an error) or idle. */
+function runState(s) {
+  if (s.running) return "running";
+  if (s.outcome !== null && s.outcome !== undefined) return "done";
+  return s.error ? "failed" : "idle";
+}
+
+/** Whether the other machines that ended without an outcome failed: /api/machines does not say,
+ * their status does (asked once per change of their last_seq). */
+function checkEndings() {
+  for (const m of app.machines) {
+    if (m.name === app.name || m.running || m.outcome || app.endings.get(m.name)?.seq === m.last_seq) continue;
+    const ending = { seq: m.last_seq, error: null };
+    app.endings.set(m.name, ending);
+    api.status(m.name).then((s) => {
+      ending.error = s.error;
+      fillPicker();
+    }).catch(() => app.endings.delete(m.name)); // asked again at the next poll
+  }
+}
+
 function fillPicker() {
   const picker = $("machine-picker");
   const have = [...picker.options].map((o) => o.value + "\u0000" + o.textContent).join("\u0001");
   const labels = app.machines.map((m) => {
-    const live = m.name === app.name && app.status?.structure ? app.status : m; // the stream is fresher
-    const state = live.running ? "running" : live.outcome ? "→ " + live.outcome : "idle";
-    return [m.name, `${m.name}  (${state}${m.source === "ingest" ? ", remote" : ""})`];
+    const live = m.name === app.name && app.status?.structure
+      ? app.status // the stream is fresher
+      : { running: m.running, outcome: m.outcome, error: app.endings.get(m.name)?.error };
+    const state = runState(live);
+    const text = state === "done" ? "→ " + live.outcome : state;
+    return [m.name, `${m.name}  (${text}${m.source === "ingest" ? ", remote" : ""})`];
   });
   if (labels.map(([v, t]) => v + "\u0000" + t).join("\u0001") === have) return;
   picker.replaceChildren(...labels.map(([value, text]) => {
@@ -171,6 +197,7 @@ function openMachine(name) {
     },
   });
   app.stream.start();
+  checkEndings(); // the machine shown so far is one of the others now
   queueRender();
 }
 
@@ -425,17 +452,13 @@ function updateControls() {
   $("preempt-btn").disabled = !live || !running || entry?.source !== "local";
   $("start-btn").disabled = !live || running || !entry || !entry.can_start;
   const pill = $("run-state");
-  let text = "—";
-  let cls = "idle";
   const s = app.status;
-  if (s && s.structure) {
-    if (s.running) [text, cls] = ["running", "running"];
-    else if (s.error && s.outcome === null) [text, cls] = ["failed: " + (s.error.exc_type || "error"), "failed"];
-    else if (s.outcome !== null && s.outcome !== undefined) [text, cls] = ["finished: " + s.outcome, "done"];
-    else [text, cls] = ["idle", "idle"];
-  }
+  const state = s?.structure ? runState(s) : "idle";
+  let text = s?.structure ? state : "—";
+  if (state === "failed") text = "failed: " + (s.error.exc_type || "error");
+  if (state === "done") text = "finished: " + s.outcome;
   if (pill.textContent !== text) pill.textContent = text;
-  pill.className = "pill " + cls;
+  pill.className = "pill " + state;
   pill.title = s?.error ? `${s.error.exc_type || ""} ${s.error.message || ""}`.trim() : "";
 }
 
@@ -478,6 +501,18 @@ function queueRender() {
   requestAnimationFrame(render);
 }
 
+/** The failing state and the containers it brought down (they ended without an outcome). */
+function failedPaths(s) {
+  if (!s.error || !s.error.path) return [];
+  const failing = s.error.state ? s.error.path + "/" + s.error.state : s.error.path;
+  const failed = [failing];
+  for (let p = parentPath(failing); p; p = parentPath(p)) {
+    const entry = s.containers[p];
+    if (entry && !entry.running && entry.outcome === null) failed.push(p);
+  }
+  return failed;
+}
+
 function render() {
   app.renderQueued = false;
   const s = app.status;
@@ -487,10 +522,9 @@ function render() {
   const reached = Object.entries(s.containers)
     .filter(([, c]) => !c.running && c.outcome !== null && c.outcome !== undefined)
     .map(([p, c]) => `o:${p}:${c.outcome}`);
-  const failed = [];
-  if (s.error && s.error.path) failed.push(s.error.state ? s.error.path + "/" + s.error.state : s.error.path);
+  const failed = failedPaths(s);
   graph.apply({ active, running, reached, lastEdges: [...app.lastEdge.values()], failed, selected: app.selected });
-  tree.update(s);
+  tree.update(s, failed);
   log.flush();
   fillPicker();
   const udPath = userdata.path;

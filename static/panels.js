@@ -84,14 +84,14 @@ export class TreeView {
     else this.collapsed.delete(path);
   }
 
-  update(status) {
+  /** @param {string[]} failed the failing state and the containers it brought down */
+  update(status, failed) {
     const active = new Set(status.activePaths());
     if (status.running && status.root_path) active.add(status.root_path);
-    const failedState = status.error && status.error.path
-      ? (status.error.state ? status.error.path + "/" + status.error.state : status.error.path) : null;
+    const failedSet = new Set(failed);
     for (const [path, row] of this.rows) {
       row.classList.toggle("active", active.has(path));
-      row.classList.toggle("failed", path === failedState);
+      row.classList.toggle("failed", failedSet.has(path));
       const entry = status.containers[path];
       const out = row.lastElementChild;
       const text = entry && !entry.running && entry.outcome ? "→ " + entry.outcome : "";

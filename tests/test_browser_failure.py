@@ -1,0 +1,97 @@
+"""A run that fails: the failing state and the containers it brought down are drawn failed, and the
+machine picker says so."""
+
+from __future__ import annotations
+
+import threading
+
+import fsm
+import pytest
+from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from server.introspection_server import ServerThread
+
+ERROR_RED = "rgb(198, 40, 40)"  # --err of static/style.css
+
+
+def failing_machine():
+    """SM_ROOT: SUB(BAD raises ValueError) -> done."""
+    def bad(ud):
+        raise ValueError("boom")
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        sub = fsm.StateMachine(outcomes=["ok"])
+        with sub:
+            fsm.StateMachine.add("BAD", fsm.CBState(bad, outcomes=["go"]), {"go": "ok"})
+        fsm.StateMachine.add("SUB", sub, {"ok": "done"})
+    return sm
+
+
+def calm_machine():
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("REST", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "done"})
+    return sm
+
+
+def run_to_failure(sm):
+    with pytest.raises(fsm.SmachError):
+        sm.execute()
+
+
+@pytest.fixture(scope="module")
+def served():
+    """A server with the machine `crash` (not run yet) and `calm` (never run)."""
+    srv = ServerThread().start()
+    crash = failing_machine()
+    srv.hub.add_local(crash, name="crash")
+    srv.hub.add_local(calm_machine(), name="calm")
+    srv.crash = crash
+    yield srv
+    srv.stop()
+
+
+@pytest.fixture(scope="module")
+def failed(browser, served):  # noqa: F811
+    """A page that watched `crash` fail."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    page = watch(browser, served, "crash")
+    runner = threading.Thread(target=run_to_failure, args=(served.crash,))
+    runner.start()
+    runner.join(10)
+    page.wait_for_selector("#run-state.failed")
+    yield page
+    assert not page.errors
+
+
+def stroke(page, selector):
+    return page.eval_on_selector(selector, "el => getComputedStyle(el).stroke")
+
+
+def test_the_failing_state_is_drawn_failed(failed):
+    failed.wait_for_selector('[id="s:/SM_ROOT/SUB/BAD"].failed')
+    assert stroke(failed, '[id="s:/SM_ROOT/SUB/BAD"] > path') == ERROR_RED
+
+
+def test_an_open_container_that_failed_is_drawn_failed(failed):
+    failed.wait_for_selector('[id="c:/SM_ROOT/SUB"].cluster.failed')
+    assert stroke(failed, '[id="c:/SM_ROOT/SUB"] > polygon.frame') == ERROR_RED
+
+
+def test_a_closed_container_that_failed_is_drawn_failed(failed):
+    failed.select_option("#depth", "1")  # only the root open: SUB is one node
+    failed.wait_for_selector('[id="s:/SM_ROOT/SUB"].failed')
+    shape = failed.eval_on_selector('[id="s:/SM_ROOT/SUB"]', "g => g.querySelector(':scope > polygon, :scope > path').localName")
+    assert stroke(failed, '[id="s:/SM_ROOT/SUB"] > %s' % shape) == ERROR_RED
+
+
+def test_the_picker_says_failed_for_the_machine_shown(failed):
+    failed.wait_for_selector('#machine-picker option[value="crash"]:has-text("failed")', state="attached")
+
+
+def test_the_picker_says_failed_for_another_machine_whose_run_failed(browser, served, failed):  # noqa: F811
+    page = watch(browser, served, "calm")
+    page.wait_for_selector('#machine-picker option[value="crash"]:has-text("failed")', state="attached")
+    assert "failed" not in page.text_content('#machine-picker option[value="calm"]')
+    assert not page.errors
+    page.close()

@@ -1,9 +1,10 @@
 """Reads JSON Lines event logs: every complete event, with line-numbered problems for the rest.
 
 * ``read_events(path)`` yields events in file order. A line that is not a complete event
-  (a crash cut it short, or it is corrupt) is skipped and reported, with its line number,
-  to ``on_problem`` (and kept in ``Reader.problems``). An event whose schema version is
-  unknown stops the read with ``SchemaError``: guessing at it would be worse.
+  (a crash cut it short, or it is corrupt), or whose event does not fit the schema
+  (``fsm.schema.validate``), is skipped and reported, with its line number, to
+  ``on_problem`` (and kept in ``Reader.problems``). An event of a newer schema version stops
+  the read with ``SchemaError``: guessing at it would be worse.
 * ``follow(path)`` does the same for a log still being written, until its writer is gone.
 * ``seek(path, machine, seq)`` rebuilds one machine's state at one event from the nearest
   snapshot (found through the ``.idx`` sidecar), or by scanning when the index is missing
@@ -90,7 +91,7 @@ class Reader:
             return None
         version = event.get("v")
         if version not in SUPPORTED_VERSIONS:
-            if type(version) is int:
+            if type(version) is int and version > max(SUPPORTED_VERSIONS):  # a newer fsmscope wrote it
                 raise SchemaError("%s line %d: schema version %d is not supported (this fsmscope reads version %s)"
                                   % (self.path, self.lineno, version, ", ".join(map(str, SUPPORTED_VERSIONS))))
             self._problem("no schema version ('v')" if version is None else "bad schema version %r" % (version,))

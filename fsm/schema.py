@@ -181,18 +181,25 @@ def _fields_problem(obj: Any, fields: tuple[Field, ...], what: str = "") -> str 
 
 # The structure tree (a ``structure`` event's root, a snapshot's structure).
 
-TRANSITION_FIELDS = (Field("from", STR), Field("outcome", STR), Field("to", OPT_STR))
+TRANSITION_FIELDS = (Field("from", STR, doc="a child's label"), Field("outcome", STR, doc="one of its outcomes"),
+                     Field("to", OPT_STR, doc="a child's label, a container outcome, or null (the container "
+                                              "outcome of the same name)"))
 NODE_FIELDS = (
-    Field("label", STR), Field("path", PATH), Field("type", STR), Field("container", BOOL),
-    Field("outcomes", LIST_STR), Field("input_keys", LIST_STR), Field("output_keys", LIST_STR),
-    Field("remapping", MAP_STR),
+    Field("label", STR, doc="the name its parent knows it by"),
+    Field("path", PATH, doc="its parent's path, '/', its label"),
+    Field("type", STR, doc="the class name (StateMachine, Concurrence, CBState, ...)"),
+    Field("container", BOOL, doc="whether it holds children"),
+    Field("outcomes", LIST_STR, doc="registered outcomes, sorted"),
+    Field("input_keys", LIST_STR, doc="sorted"), Field("output_keys", LIST_STR, doc="sorted"),
+    Field("remapping", MAP_STR, doc="its parent's remapping for it: {its key: the parent's key}"),
 )
 CONTAINER_FIELDS = (
-    Field("initial", LIST_STR), Field("transitions", _list_of(Type("a transition", lambda t: _fields_problem(
-        t, TRANSITION_FIELDS)), "a list of transitions")),
-    Field("children", _simple("a list", (list,))),
-    Field("default_outcome", OPT_STR, required=False), Field("outcome_map", _object_of(MAP_STR, "an object"),
-                                                             required=False),
+    Field("initial", LIST_STR, doc="initial states"), Field("transitions", _list_of(Type("a transition", lambda t: _fields_problem(
+        t, TRANSITION_FIELDS)), "a list of transitions"), doc="its edges (below)"),
+    Field("children", _simple("a list", (list,)), doc="nodes, in add order"),
+    Field("default_outcome", OPT_STR, required=False, doc="a Concurrence's"),
+    Field("outcome_map", _object_of(MAP_STR, "an object of objects of strings"), required=False,
+          doc="a Concurrence's {container outcome: {child: outcome}}"),
 )
 
 
@@ -229,14 +236,17 @@ def node_problem(node: Any, path: str | None = None) -> str | None:
 
 NODE = Type("a structure node (below)", lambda v: node_problem(v))
 
-CONTAINER_STATUS_FIELDS = (Field("active", LIST_STR), Field("initial", LIST_STR), Field("userdata", OBJECT),
-                           Field("running", BOOL), Field("outcome", OPT_STR))
+CONTAINER_STATUS_FIELDS = (Field("active", LIST_STR, doc="active children's labels"),
+                           Field("initial", LIST_STR, doc="initial children's labels"),
+                           Field("userdata", OBJECT, doc="its userdata, encoded"),
+                           Field("running", BOOL), Field("outcome", OPT_STR, doc="its last outcome"))
 STATUS_FIELDS = (
-    Field("run", OPT_STR, required=False), Field("root_path", _nullable(PATH), required=False),
-    Field("structure", _nullable(NODE), required=False),
+    Field("run", OPT_STR, required=False, doc="the current (or last) run"),
+    Field("root_path", _nullable(PATH), required=False), Field("structure", _nullable(NODE), required=False),
     Field("containers", _object_of(Type("a container status", lambda c: _fields_problem(
         c, CONTAINER_STATUS_FIELDS)), "an object of container statuses")),
-    Field("running", BOOL), Field("outcome", OPT_STR), Field("error", _nullable(OBJECT), required=False),
+    Field("running", BOOL, doc="the root is running"), Field("outcome", OPT_STR, doc="the root's last outcome"),
+    Field("error", _nullable(OBJECT), required=False, doc="the last error event's fields"),
     Field("last_seq", SEQ, required=False), Field("last_t", OPT_NUMBER, required=False),
 )
 STATUS = Type("a machine status (fsm.status.Status.to_dict())",
@@ -259,34 +269,37 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
     Kind("structure", "The whole container tree.", (
         Field("root", NODE, doc="the root container's node; its path is the event's path"),)),
     Kind("start", "A container began executing.", (
-        Field("initial", LIST_STR), Field("active", LIST_STR),
+        Field("initial", LIST_STR), Field("active", LIST_STR, doc="a Concurrence: all its children"),
         Field("userdata", OBJECT, doc="the container's whole userdata, encoded"))),
     Kind("transition", "The container's active states changed.", (
-        Field("from", STR), Field("outcome", STR),
+        Field("from", STR, doc="the state that returned"), Field("outcome", STR, doc="what it returned"),
         Field("to", OPT_STR, doc="the next state; null when a Concurrence child finished"),
-        Field("active", LIST_STR))),
+        Field("active", LIST_STR, doc="the container's active states now"))),
     Kind("terminate", "A container finished.", (
-        Field("last", LIST_STR), Field("outcome", OPT_STR, doc="null: ended without an outcome"),
-        Field("active", LIST_STR, required=False),
+        Field("last", LIST_STR, doc="the last active state(s)"),
+        Field("outcome", OPT_STR, doc="null: ended without an outcome"), Field("active", LIST_STR, required=False),
         Field("state_outcome", OPT_STR, required=False, doc="the outcome the last state returned"),
         Field("outcomes", MAP_OPT_STR, required=False, doc="a Concurrence's children's outcomes"),
         Field("error", OPT_STR, required=False, doc="'ExceptionClass: message' when it failed"))),
     Kind("userdata", "Keys of a container's userdata written since the last such event.", (
-        Field("changes", OBJECT),)),
+        Field("changes", OBJECT, doc="{key: encoded value}"),)),
     Kind("preempt", "A preempt was requested of, or serviced by, the state at path.", (
         Field("phase", _one_of("requested", "serviced")),)),
     Kind("error", "A state raised, or a container failed.", (
-        Field("state", OPT_STR), Field("exc_type", STR), Field("message", STR),
-        Field("traceback", STR, required=False), Field("wrapped_as", STR, required=False))),
+        Field("state", OPT_STR, doc="the child that raised"), Field("exc_type", STR, doc="the root cause's class"),
+        Field("message", STR), Field("traceback", STR, required=False, doc="the whole chain"),
+        Field("wrapped_as", STR, required=False, doc="the SMACH exception that carried it"))),
     Kind("log", "A log line the other events do not already say.", (
         Field("level", _one_of("debug", "info", "warn", "error")), Field("msg", STR))),
     Kind("feedback", "Action feedback received by a SimpleActionState.", (
-        Field("action", STR), Field("feedback", JSON))),
+        Field("action", STR, doc="the action's name"), Field("feedback", JSON, doc="encoded"))),
     Kind("control", "Somebody asked the machine to do something.", (
-        Field("action", STR), Field("reason", OPT_STR, required=False), Field("client", STR),
-        Field("result", STR, doc="'accepted' or why not"), Field("params", OBJECT, required=False))),
+        Field("action", STR, doc="preempt, initial-state, start, publish, ..."),
+        Field("reason", OPT_STR, required=False, doc="the operator's words"),
+        Field("client", STR, doc="who asked (an address)"), Field("result", STR, doc="'accepted' or why not"),
+        Field("params", OBJECT, required=False, doc="what was asked"))),
     Kind("snapshot", "The full rebuilt state of one machine at seq.", (
-        Field("status", STATUS),)),
+        Field("status", STATUS, doc="the machine's state after the event seq"),)),
 )}
 
 
@@ -358,13 +371,13 @@ def _problem(ev: Any) -> str | None:
 # characters, so those (and '%', to keep the mapping one to one) are percent-escaped.
 
 ID_PREFIXES = {"state": "s:", "container": "c:", "outcome": "o:", "edge": "e:"}
-_ESCAPED = {c: "%%%02X" % c for c in [*range(0x20), 0x25, 0x7F]}
-_ESCAPED.update({c: "%%u%04X" % c for c in (0xFFFE, 0xFFFF)})
+ID_ESCAPES = {c: "%%%02X" % c for c in [*range(0x20), 0x25, 0x7F]}
+ID_ESCAPES.update({c: "%%u%04X" % c for c in (0xFFFE, 0xFFFF)})
 
 
 def id_text(text: str) -> str:
     """``text`` safe for an XML attribute: control characters and '%' percent-escaped."""
-    return text.translate(_ESCAPED)
+    return text.translate(ID_ESCAPES)
 
 
 def state_id(path: str) -> str:

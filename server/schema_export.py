@@ -1,0 +1,103 @@
+"""The event schema (fsm/schema.py) as the browser and the docs read it.
+
+``static/schema.js`` and the field tables of ``docs/events.md`` are generated from the one
+definition in ``fsm.schema``; ``tests/test_schema_export.py`` regenerates both and fails on any
+difference. After changing the schema: ``python -m server.schema_export``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+
+from fsm import schema
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+JS_PATH = os.path.join(ROOT, "static", "schema.js")
+DOC_PATH = os.path.join(ROOT, "docs", "events.md")
+_BLOCK = re.compile(r"(<!-- schema:(\w+) -->\n).*?(<!-- /schema -->)", re.S)
+
+
+def javascript() -> str:
+    """The text of static/schema.js."""
+    escapes = {chr(code): text for code, text in schema.ID_ESCAPES.items()}
+    pattern = "".join("\\u%04x" % ord(c) for c in escapes)
+    return """// Generated from fsm/schema.py by `python -m server.schema_export`: do not edit by hand
+// (tests/test_schema_export.py fails when this file and the Python definition differ).
+
+/** The event schema version this page reads. */
+export const SCHEMA_VERSION = %(version)d;
+
+/** Every event kind. */
+export const KINDS = Object.freeze(%(kinds)s);
+
+/** Where a served machine's events come from, and which of those a dashboard may control. */
+export const SOURCES = Object.freeze(%(sources)s);
+export const CONTROLLABLE_SOURCES = Object.freeze(%(controllable)s);
+
+// Graph element ids: a path can hold any character; control characters and '%%' are
+// percent-escaped (one to one), as the server's SVG writes them.
+const ESCAPED = new Map(Object.entries(%(escapes)s));
+const NEEDS_ESCAPE = /[%(pattern)s]/;
+
+export function idText(text) {
+  text = String(text);
+  if (!NEEDS_ESCAPE.test(text)) return text;
+  let out = "";
+  for (const ch of text) out += ESCAPED.get(ch) ?? ch;
+  return out;
+}
+
+export const stateId = (path) => "%(s)s" + idText(path);
+export const containerId = (path) => "%(c)s" + idText(path);
+export const outcomeId = (path, outcome) => `%(o)s${idText(path)}:${idText(outcome)}`;
+export const edgeId = (path, from, outcome) => `%(e)s${idText(path)}:${idText(from)}:${idText(outcome)}`;
+""" % {"version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
+       "sources": json.dumps({s: s for s in schema.SOURCES}), "controllable": json.dumps(list(schema.CONTROLLABLE_SOURCES)),
+       "escapes": json.dumps(escapes), "pattern": pattern,
+       "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
+       "e": schema.ID_PREFIXES["edge"]}
+
+
+def _table(fields: tuple[schema.Field, ...]) -> str:
+    rows = ["| field | type | required | meaning |", "|---|---|---|---|"]
+    for f in fields:
+        rows.append("| `%s` | %s | %s | %s |" % (f.name, f.type.name, "yes" if f.required else "no", f.doc))
+    return "\n".join(rows) + "\n"
+
+
+def tables() -> dict[str, str]:
+    """Every generated table of docs/events.md, by the name its block carries."""
+    out = {name: _table(kind.fields) for name, kind in schema.KINDS.items()}
+    out.update(envelope=_table(schema.ENVELOPE), node=_table(schema.NODE_FIELDS),
+               container=_table(schema.CONTAINER_FIELDS), transition=_table(schema.TRANSITION_FIELDS),
+               status=_table(schema.STATUS_FIELDS), container_status=_table(schema.CONTAINER_STATUS_FIELDS))
+    return out
+
+
+def events_doc(text: str) -> str:
+    """docs/events.md with every ``<!-- schema:NAME -->`` block filled from the schema."""
+    generated = tables()
+
+    def fill(match: re.Match) -> str:
+        return match.group(1) + generated[match.group(2)] + match.group(3)
+    return _BLOCK.sub(fill, text)
+
+
+def blocks(text: str) -> set[str]:
+    """The names of the generated blocks a text holds."""
+    return {m.group(2) for m in _BLOCK.finditer(text)}
+
+
+def main() -> None:
+    with open(JS_PATH, "w", encoding="utf-8") as handle:
+        handle.write(javascript())
+    with open(DOC_PATH, encoding="utf-8") as handle:
+        doc = handle.read()
+    with open(DOC_PATH, "w", encoding="utf-8") as handle:
+        handle.write(events_doc(doc))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,30 @@
+// Generated from fsm/schema.py by `python -m server.schema_export`: do not edit by hand
+// (tests/test_schema_export.py fails when this file and the Python definition differ).
+
+/** The event schema version this page reads. */
+export const SCHEMA_VERSION = 1;
+
+/** Every event kind. */
+export const KINDS = Object.freeze(["structure", "start", "transition", "terminate", "userdata", "preempt", "error", "log", "feedback", "control", "snapshot"]);
+
+/** Where a served machine's events come from, and which of those a dashboard may control. */
+export const SOURCES = Object.freeze({"local": "local", "ingest": "ingest", "replay": "replay"});
+export const CONTROLLABLE_SOURCES = Object.freeze(["local"]);
+
+// Graph element ids: a path can hold any character; control characters and '%' are
+// percent-escaped (one to one), as the server's SVG writes them.
+const ESCAPED = new Map(Object.entries({"\u0000": "%00", "\u0001": "%01", "\u0002": "%02", "\u0003": "%03", "\u0004": "%04", "\u0005": "%05", "\u0006": "%06", "\u0007": "%07", "\b": "%08", "\t": "%09", "\n": "%0A", "\u000b": "%0B", "\f": "%0C", "\r": "%0D", "\u000e": "%0E", "\u000f": "%0F", "\u0010": "%10", "\u0011": "%11", "\u0012": "%12", "\u0013": "%13", "\u0014": "%14", "\u0015": "%15", "\u0016": "%16", "\u0017": "%17", "\u0018": "%18", "\u0019": "%19", "\u001a": "%1A", "\u001b": "%1B", "\u001c": "%1C", "\u001d": "%1D", "\u001e": "%1E", "\u001f": "%1F", "%": "%25", "\u007f": "%7F", "\ufffe": "%uFFFE", "\uffff": "%uFFFF"}));
+const NEEDS_ESCAPE = /[\u0000\u0001\u0002\u0003\u0004\u0005\u0006\u0007\u0008\u0009\u000a\u000b\u000c\u000d\u000e\u000f\u0010\u0011\u0012\u0013\u0014\u0015\u0016\u0017\u0018\u0019\u001a\u001b\u001c\u001d\u001e\u001f\u0025\u007f\ufffe\uffff]/;
+
+export function idText(text) {
+  text = String(text);
+  if (!NEEDS_ESCAPE.test(text)) return text;
+  let out = "";
+  for (const ch of text) out += ESCAPED.get(ch) ?? ch;
+  return out;
+}
+
+export const stateId = (path) => "s:" + idText(path);
+export const containerId = (path) => "c:" + idText(path);
+export const outcomeId = (path, outcome) => `o:${idText(path)}:${idText(outcome)}`;
+export const edgeId = (path, from, outcome) => `e:${idText(path)}:${idText(from)}:${idText(outcome)}`;

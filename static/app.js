@@ -51,7 +51,7 @@ const userdata = new UserdataPanel($("userdata"), $("ud-container"), {
   redraw: () => queueRender(),
 });
 const log = new EventLog($("log"), {
-  kind: $("log-kind"), path: $("log-path"), count: $("log-count"), clear: $("log-clear"),
+  kinds: $("log-kinds"), text: $("log-filter"), count: $("log-count"), clear: $("log-clear"),
 }, { select: (path) => select(path) });
 log.nodeOf = (path) => app.nodes.get(path);
 const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"));

@@ -1,6 +1,7 @@
 // The side panels: the hierarchy tree, a container's userdata, the event log.
 // Every name, value and message goes in as text (createElement + textContent), never as HTML.
 
+import { KINDS } from "./schema.js";
 import { parentPath } from "./status.js";
 import { transcript, valueText } from "./transcript.js";
 
@@ -204,22 +205,67 @@ function clock(t) {
   return `${pad(d.getHours())}:${pad(d.getMinutes())}:${pad(d.getSeconds())}.${pad(d.getMilliseconds(), 3)}`;
 }
 
-/** The event log, filtered by kind and path; clicking a row selects the state it is about. */
+/** The words of an event the text filter searches besides its transcript line: the states and outcomes it names. */
+function searchedWords(ev) {
+  const words = [ev.kind, ev.path, ev.from, ev.to, ev.state, ev.outcome, ev.state_outcome,
+    ...[].concat(ev.active ?? [], ev.last ?? []), ...Object.entries(ev.outcomes ?? {}).flat()];
+  return words.filter((w) => typeof w === "string");
+}
+
+/** The kinds the log shows: a checkbox per kind in a <details> popover, closed by Escape or a click elsewhere. */
+class KindFilter {
+  constructor(details, changed) {
+    this.summary = details.querySelector("summary");
+    this.boxes = KINDS.map((kind) => h("input", { type: "checkbox", value: kind, checked: true }));
+    details.querySelector(".kinds-actions").before(...this.boxes.map((box) => h("label", {}, box, " " + box.value)));
+    this._read();
+    const update = () => {
+      this._read();
+      changed();
+    };
+    details.addEventListener("change", update);
+    details.addEventListener("click", (e) => {
+      const button = e.target.closest("button[data-check]");
+      if (!button) return;
+      for (const box of this.boxes) box.checked = button.dataset.check === "all";
+      update();
+    });
+    details.addEventListener("keydown", (e) => {
+      if (e.key !== "Escape" || !details.open) return;
+      details.open = false;
+      this.summary.focus();
+    });
+    document.addEventListener("click", (e) => {
+      if (!details.contains(e.target)) details.open = false;
+    });
+  }
+
+  _read() {
+    this.hidden = new Set(this.boxes.filter((b) => !b.checked).map((b) => b.value)); // the kinds not shown
+    const shown = this.boxes.length - this.hidden.size;
+    this.summary.textContent = !this.hidden.size ? "all kinds" : shown ? `${shown} of ${this.boxes.length} kinds` : "no kinds";
+  }
+}
+
+/** The event log, filtered by kinds and by text; clicking a row selects the state it is about. */
 export class EventLog {
   constructor(host, controls, handlers) {
     this.host = host;
-    this.controls = controls; // {kind: select, path: input, count: element, clear: button}
+    this.controls = controls; // {kinds: <details> of checkboxes, text: input, count: element, clear: button}
     this.handlers = handlers;
     this.events = [];
+    this.shown = 0; // how many of this.events pass the filters
     this.pending = []; // events not drawn yet
+    this.described = new WeakMap(); // event -> {line, text}: its transcript line and the text the filter searches
+    this.needle = ""; // the text filter, lower case
     this.stick = true; // follow the newest row (false once the user scrolls up)
     host.addEventListener("scroll", () => {
       this.stick = host.scrollHeight - host.scrollTop - host.clientHeight < 24;
     }, { passive: true });
     this.nodeOf = () => undefined;
     this.selectedRow = null;
-    controls.kind.addEventListener("change", () => this.redraw());
-    controls.path.addEventListener("input", () => this.redraw());
+    this.kinds = new KindFilter(controls.kinds, () => this.redraw());
+    controls.text.addEventListener("input", () => this.redraw());
     controls.clear.addEventListener("click", () => { this.events = []; this.redraw(); });
     host.addEventListener("click", (e) => {
       const row = e.target.closest(".log-row");
@@ -236,15 +282,23 @@ export class EventLog {
     this.redraw();
   }
 
+  /** An event's transcript line and searched text, worked out once (the filter and the row both need them). */
+  _describe(ev) {
+    let d = this.described.get(ev);
+    if (!d) {
+      const line = transcript(ev, this.nodeOf);
+      d = { line, text: [...searchedWords(ev), line.text].join("\n").toLowerCase() };
+      this.described.set(ev, d);
+    }
+    return d;
+  }
+
   _matches(ev) {
-    const kind = this.controls.kind.value;
-    if (kind && ev.kind !== kind) return false;
-    const text = this.controls.path.value.trim();
-    return !text || ev.path.toLowerCase().includes(text.toLowerCase());
+    return !this.kinds.hidden.has(ev.kind) && (!this.needle || this._describe(ev).text.includes(this.needle));
   }
 
   _row(ev) {
-    const line = transcript(ev, this.nodeOf);
+    const line = this._describe(ev).line;
     return h("div", { class: `log-row kind-${ev.kind} level-${line.level}`, "data-select": selectionOf(ev), "data-seq": String(ev.seq) },
       h("span", { class: "seq", text: String(ev.seq) }),
       h("span", { class: "time", text: clock(ev.t) }),
@@ -253,11 +307,14 @@ export class EventLog {
       h("span", { class: "msg", text: line.text, title: ev.kind === "error" && ev.traceback ? ev.traceback : line.text }));
   }
 
-
   /** Keep events; their rows are drawn by the next flush() (once per animation frame, however fast they come). */
   add(events) {
-    for (const ev of events) this.events.push(ev);
-    if (this.events.length > MAX_EVENTS) this.events.splice(0, this.events.length - MAX_EVENTS);
+    for (const ev of events) {
+      this.events.push(ev);
+      if (this._matches(ev)) this.shown += 1;
+    }
+    const dropped = this.events.length > MAX_EVENTS ? this.events.splice(0, this.events.length - MAX_EVENTS) : [];
+    for (const ev of dropped) if (this._matches(ev)) this.shown -= 1;
     for (const ev of events) this.pending.push(ev);
     if (this.pending.length > 4 * MAX_ROWS_PER_FRAME) this.pending.splice(0, this.pending.length - MAX_ROWS_PER_FRAME);
   }
@@ -278,9 +335,13 @@ export class EventLog {
     if (stick) this.host.scrollTop = this.host.scrollHeight;
   }
 
+  /** Draw again from the kept events (the filters or the events changed). */
   redraw() {
     this.pending = [];
-    const rows = this.events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS).map((ev) => this._row(ev));
+    this.needle = this.controls.text.value.trim().toLowerCase();
+    const matching = this.events.filter((ev) => this._matches(ev));
+    this.shown = matching.length;
+    const rows = matching.slice(-MAX_ROWS).map((ev) => this._row(ev));
     this.host.replaceChildren(...(rows.length ? rows : [h("p", { class: "empty", text: "No events." })]));
     this.selectedRow = null;
     this._count();
@@ -289,6 +350,6 @@ export class EventLog {
   }
 
   _count() {
-    this.controls.count.textContent = `${this.events.length} events`;
+    this.controls.count.textContent = `${this.shown} / ${this.events.length} events`;
   }
 }

@@ -220,3 +220,13 @@ class Firefox:
                 self.proc.wait()
         self._log.close()
         self._dir.cleanup()
+
+
+def filter_log(page, text: str = "", kinds=None) -> None:
+    """Filter the event log as a user does: ``text`` in the search box, only ``kinds`` ticked (None: all)."""
+    page.fill("#log-filter", text)
+    page.click("#log-kinds > summary")  # opens the popover of kinds
+    page.click("#log-kinds button[data-check=%s]" % ("all" if kinds is None else "none"))
+    for kind in kinds or ():
+        page.check("#log-kinds input[value=%s]" % kind)
+    page.keyboard.press("Escape")

@@ -15,7 +15,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
-from browser_support import ACTIVE_LEAF, browser, free_port  # noqa: F401 (browser is a fixture)
+from browser_support import ACTIVE_LEAF, browser, filter_log, free_port  # noqa: F401 (browser is a fixture)
 
 XSS = "<img src=x onerror=alert(1)>"
 ROOT = Path(__file__).resolve().parents[1]
@@ -201,12 +201,11 @@ def test_container_userdata_highlights_changed_keys(page, server):
 
 def test_event_log_filters_and_selects(page, server):
     ensure_running(page, server)
-    page.select_option("#log-kind", "transition")
-    page.fill("#log-path", "NESTED")
+    filter_log(page, "/SM_ROOT/NESTED", ["transition"])
     page.wait_for_selector("#log .log-row")
     kinds = page.eval_on_selector_all("#log .log-row .kind", "els => els.map(e => e.textContent)")
     paths = page.eval_on_selector_all("#log .log-row .path", "els => els.map(e => e.textContent)")
-    assert set(kinds) == {"transition"} and all("NESTED" in p for p in paths)
+    assert set(kinds) == {"transition"} and set(paths) == {"/SM_ROOT/NESTED"}
     assert "State machine transitioning 'A':'next'-->'B'" in page.text_content("#log")
     page.click("#log .log-row >> nth=-1")
     assert page.evaluate("window.fsmscope.selected") == "/SM_ROOT/NESTED/B"
@@ -220,7 +219,7 @@ def test_names_and_values_render_as_text(page, server):
     page.wait_for_selector('[id="s:/SM_ROOT/%s"].active' % XSS)
     graph_text = page.text_content("#graph")
     assert XSS in graph_text
-    page.select_option("#log-kind", "transition")
+    filter_log(page, kinds=["transition"])
     page.wait_for_function("(x) => document.getElementById('log').textContent.includes(x)", arg=XSS)
     # Nothing was parsed as markup anywhere: no <img>, no handler ran.
     assert page.evaluate("document.querySelectorAll('img').length") == 0
@@ -266,7 +265,7 @@ def test_set_initial_state_validates_json(page, server):
     page.click("#initial-dialog button[value=send]")
     page.wait_for_selector("#initial-dialog:not([open])", state="attached")
     page.wait_for_selector("#notice:has-text('Initial state of /SM_ROOT/NESTED set to B')")
-    page.select_option("#log-kind", "control")
+    filter_log(page, kinds=["control"])
     page.wait_for_selector("#log .log-row:has-text('initial-state')")
 
 

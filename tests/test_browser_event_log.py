@@ -1,0 +1,99 @@
+"""The event log: a text filter over the whole row, several kinds shown at once, a shown / total count."""
+
+from __future__ import annotations
+
+import fsm
+import pytest
+from browser_support import browser, filter_log, watch  # noqa: F401 (browser is a fixture)
+from server.introspection_server import ServerThread
+
+
+def pick_and_lift():
+    """SM_ROOT: GRASP (logs, writes `grip`) -> HANDS(LEFT | RIGHT) -> LIFT -> carried."""
+    def grasp(ud):
+        fsm.loginfo("gripper closed on the cup")
+        ud.grip = 0.8
+        return "closed"
+
+    hands = fsm.Concurrence(outcomes=["ready"], default_outcome="ready")
+    with hands:
+        fsm.Concurrence.add("LEFT", fsm.CBState(lambda ud: "ok", outcomes=["ok"]))
+        fsm.Concurrence.add("RIGHT", fsm.CBState(lambda ud: "ok", outcomes=["ok"]))
+    sm = fsm.StateMachine(outcomes=["carried"])
+    with sm:
+        fsm.StateMachine.add("GRASP", fsm.CBState(grasp, outcomes=["closed"], output_keys=["grip"]),
+                             {"closed": "HANDS"})
+        fsm.StateMachine.add("HANDS", hands, {"ready": "LIFT"})
+        fsm.StateMachine.add("LIFT", fsm.CBState(lambda ud: "up", outcomes=["up"]), {"up": "carried"})
+    return sm
+
+
+@pytest.fixture(scope="module")
+def served():
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    srv = ServerThread().start()
+    srv.sm = pick_and_lift()
+    srv.hub.add_local(srv.sm, name="pick")
+    yield srv
+    srv.stop()
+
+
+@pytest.fixture(scope="module")
+def logged(browser, served):  # noqa: F811
+    """A page whose log holds one whole run of the machine."""
+    page = watch(browser, served, "pick")
+    served.sm.execute()
+    page.wait_for_selector("#run-state:has-text('finished: carried')")
+    page.wait_for_selector("#log .log-row.kind-terminate[data-select='/SM_ROOT']")
+    yield page
+    assert not page.errors
+
+
+def rows_shown(page):
+    """Each row of the log as 'kind: message'."""
+    return page.eval_on_selector_all(
+        "#log .log-row", "rows => rows.map(r => r.querySelector('.kind').textContent + ': ' + r.querySelector('.msg').textContent)")
+
+
+def test_the_text_filter_finds_a_transition_by_the_state_it_enters(logged):
+    filter_log(logged, "LIFT")
+    assert "transition: State machine transitioning 'HANDS':'ready'-->'LIFT'" in rows_shown(logged)
+
+
+def test_the_text_filter_finds_a_concurrence_start_by_the_states_it_starts(logged):
+    filter_log(logged, "RIGHT")
+    assert [row for row in rows_shown(logged) if row.startswith("start: Concurrence starting")]
+
+
+def test_the_text_filter_finds_the_termination_by_its_outcome(logged):
+    filter_log(logged, "carried")
+    assert "terminate: State machine terminating 'LIFT':'up':'carried'" in rows_shown(logged)
+
+
+def test_the_text_filter_finds_a_log_line_by_its_message(logged):
+    filter_log(logged, "gripper closed")
+    assert rows_shown(logged) == ["log: gripper closed on the cup"]
+
+
+def test_several_kinds_can_be_hidden_at_once(logged):
+    filter_log(logged)
+    logged.click("#log-kinds > summary")
+    logged.uncheck("#log-kinds input[value=userdata]")
+    logged.uncheck("#log-kinds input[value=log]")
+    logged.keyboard.press("Escape")
+    kinds = {row.split(":")[0] for row in rows_shown(logged)}
+    assert {"start", "transition", "terminate"} <= kinds and not kinds & {"userdata", "log"}, kinds
+
+
+def test_every_kind_is_shown_by_default(browser, served):  # noqa: F811
+    page = watch(browser, served, "pick")
+    assert page.eval_on_selector_all("#log-kinds input[type=checkbox]", "boxes => boxes.every(b => b.checked)")
+    assert page.text_content("#log-kinds > summary") == "all kinds"
+    page.close()
+
+
+def test_the_count_says_shown_of_total_events(logged):
+    filter_log(logged)
+    total = len(rows_shown(logged))
+    filter_log(logged, "LIFT")
+    assert logged.text_content("#log-count") == "%d / %d events" % (len(rows_shown(logged)), total)

@@ -240,6 +240,9 @@ CONTAINER_STATUS_FIELDS = (Field("active", LIST_STR, doc="active children's labe
                            Field("initial", LIST_STR, doc="initial children's labels"),
                            Field("userdata", OBJECT, doc="its userdata, encoded"),
                            Field("running", BOOL), Field("outcome", OPT_STR, doc="its last outcome"))
+PREEMPT_FIELDS = (Field("seq", SEQ, doc="the preempt event's"), Field("t", NUMBER, doc="when it was requested"),
+                  Field("path", PATH, doc="of the container it was requested of"),
+                  Field("serviced", LIST_STR, doc="paths of the states that serviced it so far"))
 STATUS_FIELDS = (
     Field("run", OPT_STR, required=False, doc="the current (or last) run"),
     Field("root_path", _nullable(PATH), required=False), Field("structure", _nullable(NODE), required=False),
@@ -248,6 +251,9 @@ STATUS_FIELDS = (
     Field("running", BOOL, doc="the root is running"), Field("outcome", OPT_STR, doc="the root's last outcome"),
     Field("error", _nullable(OBJECT), required=False, doc="the last error event's fields"),
     Field("last_seq", SEQ, required=False), Field("last_t", OPT_NUMBER, required=False),
+    Field("run_seq", SEQ, required=False, doc="the seq of the current run's first event"),
+    Field("preempt", _nullable(Type("a pending preempt", lambda v: _fields_problem(v, PREEMPT_FIELDS))),
+          required=False, doc="a preempt requested and not over yet (below)"),
 )
 STATUS = Type("a machine status (fsm.status.Status.to_dict())",
               lambda v: _fields_problem(v, STATUS_FIELDS))

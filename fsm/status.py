@@ -35,18 +35,26 @@ class Status:
         self.error: dict | None = None
         self.last_seq = 0
         self.last_t: float | None = None
+        self.run_seq = 0  # the seq of the current run's first event: where its history starts
+        # A preempt requested and not over yet: {"seq", "t", "path", "serviced": [paths that serviced it]}.
+        self.preempt: dict | None = None
 
     def apply(self, event: dict) -> None:
         kind = event["kind"]
         path = event["path"]
         self.last_seq = event["seq"]
         self.last_t = event.get("t")
-        self.run = event.get("run", self.run)
+        run = event.get("run", self.run)
+        if run != self.run:
+            self.run, self.run_seq = run, event["seq"]
         if kind == "snapshot":
             self._load(event["status"])
             return
         if kind == "structure":
             self._set_structure(path, event["root"])
+            return
+        if kind == "preempt":
+            self._preempt(event)
             return
         if kind not in ("start", "transition", "userdata", "terminate", "error"):
             return
@@ -56,7 +64,7 @@ class Status:
         root = path == self.root_path
         if kind == "start":
             if root:  # a new run: what the previous one reached no longer describes the machine
-                self.running, self.outcome, self.error = True, None, None
+                self.running, self.outcome, self.error, self.preempt = True, None, None, None
                 for other in self.containers.values():
                     other.update(active=[], running=False, outcome=None)
             entry.update(active=list(event["active"]), initial=list(event["initial"]),
@@ -68,11 +76,31 @@ class Status:
         elif kind == "terminate":
             entry.update(active=[], running=False, outcome=event["outcome"])
             if root:
-                self.running, self.outcome = False, event["outcome"]
+                self.running, self.outcome, self.preempt = False, event["outcome"], None
                 if event.get("error") and self.error is None:
                     self.error = {"path": path, "message": event["error"]}
         elif kind == "error":
             self.error = {k: event.get(k) for k in ("path", "state", "exc_type", "message", "traceback")}
+
+    def _preempt(self, event: dict) -> None:
+        if event["phase"] == "requested":
+            if self.preempt is None and self.running:
+                self.preempt = {"seq": event["seq"], "t": event["t"], "path": event["path"], "serviced": []}
+        elif self.preempt is not None:
+            self.preempt["serviced"].append(event["path"])
+
+    def preempt_waiting_on(self) -> list[str]:
+        """The active states that have not serviced the pending preempt (none when there is none)."""
+        if self.preempt is None:
+            return []
+        serviced = set(self.preempt["serviced"])
+        return [p for p in self.active_leaves() if p not in serviced]
+
+    def active_leaves(self) -> list[str]:
+        """The full paths of the active states that are not containers themselves."""
+        active = [path + "/" + label for path, entry in self.containers.items() for label in entry["active"]
+                  if label != "None"]
+        return [p for p in active if p not in self.containers]
 
     def _set_structure(self, path: str, root: dict) -> None:
         self.root_path = path
@@ -87,7 +115,8 @@ class Status:
     def to_dict(self) -> dict:
         return {"machine": self.machine, "run": self.run, "root_path": self.root_path, "structure": self.structure,
                 "containers": copy.deepcopy(self.containers), "running": self.running, "outcome": self.outcome,
-                "error": self.error, "last_seq": self.last_seq, "last_t": self.last_t}
+                "error": self.error, "last_seq": self.last_seq, "last_t": self.last_t, "run_seq": self.run_seq,
+                "preempt": None if self.preempt is None else dict(self.preempt, serviced=list(self.preempt["serviced"]))}
 
     def _load(self, data: dict) -> None:
         self.run = data.get("run")
@@ -99,6 +128,8 @@ class Status:
         self.error = data.get("error")
         self.last_seq = data.get("last_seq", self.last_seq)
         self.last_t = data.get("last_t", self.last_t)
+        self.run_seq = data.get("run_seq", 0)
+        self.preempt = copy.deepcopy(data.get("preempt"))
 
     @classmethod
     def from_dict(cls, data: dict) -> Status:

@@ -34,6 +34,7 @@ from fsm.status import Status
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
 MAX_BATCH = 1000           # events per frame at most
+HISTORY = 5000             # events of the current run a new client is sent for its log, at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
 HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
 
@@ -94,6 +95,8 @@ class Client:
         missed = seq - self.cursor + 1 if self.cursor else 0
         if missed > 0:
             frames.append('{"type":"missed","count":%d}' % missed)
+        if not self.cursor:  # a new client: the snapshot also carries the current run's events so far
+            frame = frame[:-1] + ',"history":' + entry.history(seq) + "}"
         frames.append(frame)
         self.need_snapshot = False
         self.cursor = seq + 1
@@ -135,13 +138,12 @@ class MachineEntry:
         return self._structure_hash, self._n_states
 
     def status_dict(self) -> dict:
-        """``Status.to_dict()``, consistent (machine threads apply events to it concurrently)."""
+        """``Status.to_dict()``, consistent (machine threads apply events to it concurrently), with the
+        states a pending preempt still waits on."""
         with self.lock:
-            return self.status.to_dict()
-
-    def snapshot_dict(self) -> dict:
-        status = self.status_dict()
-        return {"type": "snapshot", "status": status, "last_seq": status["last_seq"]}
+            data = self.status.to_dict()
+            data["preempt_waiting_on"] = self.status.preempt_waiting_on()
+        return data
 
     def snapshot(self) -> tuple[int, str]:
         """(last_seq, the snapshot frame): built once per state, shared by every client that needs it."""
@@ -155,6 +157,18 @@ class MachineEntry:
         frame = dumps({"type": "snapshot", "status": data, "last_seq": key[1]}).decode()
         self._snapshot = (key[0], key[1], frame)
         return key[1], frame
+
+    def history(self, upto: int) -> str:
+        """The current run's events up to ``upto`` (from the ring, the newest ``HISTORY`` at most), as
+        JSON ``{"complete", "events"}``; ``complete`` says whether it reaches back to the run's start."""
+        with self.lock:
+            start = self.status.run_seq
+        ring = self.ring
+        first = ring[0][0] if ring else upto + 1
+        events = [encoded for seq, encoded in ring if start <= seq <= upto]
+        complete = first <= start and len(events) <= HISTORY
+        return (b'{"complete":%s,"events":[%s]}'
+                % (b"true" if complete else b"false", b",".join(events[-HISTORY:]))).decode()
 
     def running(self) -> bool:
         """Running as far as anyone can tell: a machine whose publisher left is not shown running."""

@@ -71,6 +71,13 @@ class ContainerStatus(BaseModel):
     outcome: Optional[str] = None
 
 
+class PendingPreempt(BaseModel):
+    seq: int
+    t: float = Field(description="when it was requested (wall clock, seconds)")
+    path: str = Field(description="the container it was requested of")
+    serviced: list[str] = Field(description="the states that serviced it so far")
+
+
 class MachineStatus(BaseModel):
     """``fsm.status.Status.to_dict()`` without ``structure``."""
 
@@ -83,6 +90,10 @@ class MachineStatus(BaseModel):
     error: Optional[dict[str, JsonValue]] = None
     last_seq: int
     last_t: Optional[float] = None
+    run_seq: int = Field(default=0, description="the seq of the current run's first event")
+    preempt: Optional[PendingPreempt] = Field(default=None, description="a preempt requested and not over yet")
+    preempt_waiting_on: list[str] = Field(default_factory=list, description="the active states that have not "
+                                          "serviced the pending preempt")
 
 
 class PreemptRequest(BaseModel):

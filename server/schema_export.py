@@ -72,7 +72,8 @@ def tables() -> dict[str, str]:
     out = {name: _table(kind.fields) for name, kind in schema.KINDS.items()}
     out.update(envelope=_table(schema.ENVELOPE), node=_table(schema.NODE_FIELDS),
                container=_table(schema.CONTAINER_FIELDS), transition=_table(schema.TRANSITION_FIELDS),
-               status=_table(schema.STATUS_FIELDS), container_status=_table(schema.CONTAINER_STATUS_FIELDS))
+               status=_table(schema.STATUS_FIELDS), container_status=_table(schema.CONTAINER_STATUS_FIELDS),
+               preempt=_table(schema.PREEMPT_FIELDS))
     return out
 
 
@@ -91,12 +92,13 @@ def blocks(text: str) -> set[str]:
 
 
 def main() -> None:
+    js = javascript()
     with open(JS_PATH, "w", encoding="utf-8") as handle:
-        handle.write(javascript())
+        handle.write(js)
     with open(DOC_PATH, encoding="utf-8") as handle:
-        doc = handle.read()
+        doc = events_doc(handle.read())
     with open(DOC_PATH, "w", encoding="utf-8") as handle:
-        handle.write(events_doc(doc))
+        handle.write(doc)
 
 
 if __name__ == "__main__":

@@ -40,6 +40,9 @@ export class Status {
     this.error = null;
     this.last_seq = 0;
     this.last_t = null;
+    this.run_seq = 0; // the seq of the current run's first event: where its history starts
+    // A preempt requested and not over yet: {seq, t, path, serviced: [paths that serviced it]}.
+    this.preempt = null;
   }
 
   apply(event) {
@@ -47,13 +50,21 @@ export class Status {
     const path = event.path;
     this.last_seq = event.seq;
     this.last_t = event.t === undefined ? null : event.t;
-    if ("run" in event) this.run = event.run;
+    const run = "run" in event ? event.run : this.run;
+    if (run !== this.run) {
+      this.run = run;
+      this.run_seq = event.seq;
+    }
     if (kind === "snapshot") {
       this._load(event.status);
       return;
     }
     if (kind === "structure") {
       this._setStructure(path, event.root);
+      return;
+    }
+    if (kind === "preempt") {
+      this._preempt(event);
       return;
     }
     if (!REDUCED.has(kind)) return;
@@ -65,6 +76,7 @@ export class Status {
         this.running = true;
         this.outcome = null;
         this.error = null;
+        this.preempt = null;
         for (const other of Object.values(this.containers)) {
           Object.assign(other, { active: [], running: false, outcome: null });
         }
@@ -82,6 +94,7 @@ export class Status {
       if (root) {
         this.running = false;
         this.outcome = event.outcome;
+        this.preempt = null;
         if (event.error && this.error === null) this.error = { path, message: event.error };
       }
     } else if (kind === "error") {
@@ -89,6 +102,16 @@ export class Status {
       for (const k of ["path", "state", "exc_type", "message", "traceback"]) {
         this.error[k] = event[k] === undefined ? null : event[k];
       }
+    }
+  }
+
+  _preempt(event) {
+    if (event.phase === "requested") {
+      if (this.preempt === null && this.running) {
+        this.preempt = { seq: event.seq, t: event.t, path: event.path, serviced: [] };
+      }
+    } else if (this.preempt !== null) {
+      this.preempt.serviced.push(event.path);
     }
   }
 
@@ -117,7 +140,8 @@ export class Status {
     return {
       machine: this.machine, run: this.run, root_path: this.root_path, structure: this.structure,
       containers: structuredClone(this.containers), running: this.running, outcome: this.outcome,
-      error: this.error, last_seq: this.last_seq, last_t: this.last_t,
+      error: this.error, last_seq: this.last_seq, last_t: this.last_t, run_seq: this.run_seq,
+      preempt: structuredClone(this.preempt),
     };
   }
 
@@ -131,6 +155,8 @@ export class Status {
     this.error = data.error ?? null;
     this.last_seq = data.last_seq ?? this.last_seq;
     this.last_t = data.last_t ?? this.last_t;
+    this.run_seq = data.run_seq ?? 0;
+    this.preempt = structuredClone(data.preempt ?? null);
   }
 
   static fromDict(data) {

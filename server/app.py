@@ -150,6 +150,8 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
             out.append({"name": entry.name, "running": entry.running(), "outcome": status.outcome,
                         "last_seq": status.last_seq, "root_path": status.root_path,
                         "can_start": bool(entry.handle is not None and entry.handle.can_start),
+                        "can_hold": bool(entry.handle is not None and entry.handle.holder is not None),
+                        "held": bool(entry.handle is not None and entry.handle.held),
                         "source": entry.source, "connected": entry.connected, "rejected": entry.rejected})
         return out
 
@@ -193,6 +195,16 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
         handle = local(machine(name))
         reason = body.reason if body is not None else None
         seq = await run_in_threadpool(handle.preempt, reason, client_of(request))
+        return models.SeqResponse(seq=seq)
+
+    @app.post("/api/machines/{name}/hold", status_code=202, response_model=models.SeqResponse,
+              dependencies=auth, responses=ERRORS, tags=["control"],
+              description="Let the current run finish, then start no other until the next start "
+                          "(a machine its host runs in a loop, such as the demo's episodes; 409 otherwise).")
+    async def hold(name: Annotated[str, NAME], request: Request,
+                   body: Annotated[models.PreemptRequest | None, Body()] = None) -> models.SeqResponse:
+        handle = local(machine(name))
+        seq = await run_in_threadpool(handle.hold, body.reason if body is not None else None, client_of(request))
         return models.SeqResponse(seq=seq)
 
     @app.post("/api/machines/{name}/initial-state", response_model=models.SeqResponse, dependencies=auth,

@@ -42,20 +42,25 @@ class MachineHandle:
     then a start calls ``starter()`` instead (in the request's worker thread, never on the event
     loop), for a host that runs the machine in its own loop (the sim demo: "next episode").
     A starter should return promptly; one that raises answers 409 with its message.
+
+    Such a host may also give a ``holder``: ``holder()`` asks it to start no further run until
+    the next start (the demo: "stop after this episode"). With one, a preempt that arrives
+    between two runs is not lost: it holds the loop instead of answering 409.
     """
 
     def __init__(self, machine: Any, reporter: introspection.Reporter, can_start: bool,
-                 starter: Callable[[], Any] | None = None) -> None:
+                 starter: Callable[[], Any] | None = None, holder: Callable[[], Any] | None = None) -> None:
         self.machine = machine
         self.reporter = reporter
         self.can_start = can_start
         self.starter = starter
+        self.holder = holder
+        self.held = False  # a hold was asked and no start has come since
         self.observer: Any = None
         self._lock = threading.Lock()
         self._thread: threading.Thread | None = None
         self._pending: list[tuple[Any, list[str], dict | None]] = []
         self._hook_installed = False
-        self.last_outcome: Any = None
 
     def is_running(self) -> bool:
         running = getattr(self.machine, "is_running", None)
@@ -74,11 +79,25 @@ class MachineHandle:
     # Preempt (the /sm_stop of this world).
     def preempt(self, reason: str | None, client: str) -> int:
         if not self.is_running():
+            if self.holder is not None:  # between two runs of a loop: the next one must not start
+                return self._hold("preempt", reason, client)
             self.emit_control("preempt", client, "not running", reason)
             raise ControlError(409, "machine is not running")
         seq = self.emit_control("preempt", client, "accepted", reason)
         self.machine.request_preempt()
         return seq
+
+    def hold(self, reason: str | None, client: str) -> int:
+        """Let the current run finish, then start no other until the next start."""
+        if self.holder is None:
+            self.emit_control("hold", client, "no loop to hold", reason)
+            raise ControlError(409, "this machine is not run in a loop: there is no next run to hold")
+        return self._hold("hold", reason, client)
+
+    def _hold(self, action: str, reason: str | None, client: str) -> int:
+        self.held = True
+        self.holder()
+        return self.emit_control(action, client, "accepted", reason, params={"until": "start"})
 
     # Initial state ('Set as Initial State').
     def container_at(self, path: str) -> Any:
@@ -162,6 +181,7 @@ class MachineHandle:
             pending, self._pending = self._pending, []
             for target, states, userdata in pending:
                 self._apply(target, states, userdata)
+            self.held = False
             seq = self.emit_control("start", client, "accepted")
             if self.starter is not None:
                 try:
@@ -178,9 +198,9 @@ class MachineHandle:
 
     def _run(self) -> None:
         try:
-            self.last_outcome = self.machine.execute()
+            self.machine.execute()
         except BaseException:  # reported as error and terminate events by the runtime
-            self.last_outcome = None
+            pass
 
     def join(self, timeout: float | None = None) -> None:
         thread = self._thread

@@ -305,7 +305,8 @@ class Hub:
             return "%s-%d" % (name, i)
 
     def add_local(self, machine: Any, name: str | None = None, path: str = introspection.DEFAULT_ROOT_PATH,
-                  can_start: bool = True, starter: Callable[[], Any] | None = None) -> MachineEntry:
+                  can_start: bool = True, starter: Callable[[], Any] | None = None,
+                  holder: Callable[[], Any] | None = None) -> MachineEntry:
         """Observe ``machine`` (any thread). A machine already observed keeps its reporter's name.
 
         ``starter``: what POST .../start calls (in a worker thread) instead of executing the machine
@@ -323,7 +324,7 @@ class Hub:
                                        path)
         entry = MachineEntry(self, rep.machine, "local")
         entry.reporter = rep
-        entry.handle = MachineHandle(machine, rep, can_start, starter)
+        entry.handle = MachineHandle(machine, rep, can_start, starter, holder)
         entry.status.apply(schema.event(rep.last_seq, time.time(), rep.run, rep.machine, "structure", rep.root_path,
                                         {"root": rep.structure()}))
         entry.loop_seq = rep.last_seq

@@ -31,6 +31,9 @@ class MachineInfo(BaseModel):
     last_seq: int
     root_path: Optional[str] = None
     can_start: bool
+    can_hold: bool = Field(default=False, description="its host runs it in a loop that POST .../hold can stop "
+                           "after the current run")
+    held: bool = Field(default=False, description="a hold was asked and no start has come since")
     source: Literal[SOURCES]  # type: ignore[valid-type]
     connected: Optional[bool] = Field(default=None, description="a machine of another process: whether its "
                                       "publisher is connected (null for the others)")

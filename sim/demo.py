@@ -35,15 +35,15 @@ def run_episodes(world: World, machine_factory: Callable[[World], Machine], epis
                  on_episode: Callable[[dict], Any] | None = None, *, seed: int | None = None,
                  pause: float = 1.0, stop: threading.Event | None = None,
                  on_machine: Callable[[int, Machine], Any] | None = None,
-                 resume: threading.Event | None = None) -> list[dict]:
+                 resume: threading.Event | None = None, hold: threading.Event | None = None) -> list[dict]:
     """Run ``episodes`` episodes (0: until ``stop`` is set); a list of per-episode dicts.
 
     Each episode resets the world with seed ``seed + i`` (the cube at a seeded random
     place, the arm at HOME), builds a fresh machine with ``machine_factory(world)``,
     hands it to ``on_machine(i, machine)`` (to attach a dashboard or keep it for
-    preemption), executes it, then calls ``on_episode(info)``. A 'preempted' episode
-    ends the loop unless ``continue_after_preempt``. ``pause`` is simulated seconds
-    between episodes (with the arm holding still).
+    preemption), executes it, then calls ``on_episode(info)``. After a 'preempted' episode,
+    and before any episode while ``hold`` is set, the loop waits for ``resume`` (without
+    one it ends). ``pause`` is simulated seconds between episodes (with the arm holding still).
     """
     base = world.seed if seed is None else seed
     results: list[dict] = []
@@ -51,6 +51,12 @@ def run_episodes(world: World, machine_factory: Callable[[World], Machine], epis
     while episodes <= 0 or i < episodes:
         if stop is not None and stop.is_set():
             break
+        if hold is not None and hold.is_set():  # asked to stop after the last episode, or between two
+            if resume is None or not _wait_either(resume, stop):
+                break
+            hold.clear()
+        if resume is not None:
+            resume.clear()  # a start asked for before this episode is used up by it
         ep_seed = base + i
         world.reset(ep_seed)
         world.label = "starting"
@@ -90,8 +96,8 @@ def run_episodes(world: World, machine_factory: Callable[[World], Machine], epis
 
 
 def _wait_either(resume: threading.Event, stop: threading.Event | None) -> bool:
-    """Wait for ``resume`` (True) or ``stop`` (False)."""
-    resume.clear()
+    """Wait for ``resume`` (True) or ``stop`` (False); a start asked for since the last episode
+    began counts."""
     while not resume.wait(0.1):
         if stop is not None and stop.is_set():
             return False
@@ -130,7 +136,7 @@ class SimDemo:
 
     def run(self, episodes: int = 0, on_episode=None, *, seed: int | None = None,
             pause: float | None = None, machine_factory=None, on_machine=None,
-            resume: threading.Event | None = None) -> list[dict]:
+            resume: threading.Event | None = None, hold: threading.Event | None = None) -> list[dict]:
         """Run episodes in the calling thread (see :func:`run_episodes`)."""
         def keep(i, m):
             self._keep(i, m)
@@ -140,7 +146,7 @@ class SimDemo:
         if pause is None:
             pause = 0.0 if self.world.fast else 1.0
         return run_episodes(self.world, machine_factory or self.build_machine, episodes, on_episode,
-                            seed=seed, pause=pause, stop=self.stop_event, on_machine=keep, resume=resume)
+                            seed=seed, pause=pause, stop=self.stop_event, on_machine=keep, resume=resume, hold=hold)
 
     def request_stop(self) -> None:
         """Preempt the running machine and end the episode loop (safe from any thread)."""
@@ -219,6 +225,7 @@ def run_demo(args: argparse.Namespace) -> int:
     recorder = Recorder(record_path)
     fsm.attach(machine, recorder, name=MACHINE_NAME)
     resume = threading.Event()
+    hold = threading.Event()
     server = None
     try:
         if not args.headless:
@@ -226,7 +233,7 @@ def run_demo(args: argparse.Namespace) -> int:
 
             server = ServerThread(host=args.host, port=args.port, token=args.token or None).start()
             server.hub.scene_url = demo.scene.url if demo.scene is not None else None
-            server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set)
+            server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set)
             print("fsmscope demo: open %s" % server.url, flush=True)
         print("fsmscope demo: recording to %s" % record_path, flush=True)
     except BaseException:
@@ -247,7 +254,7 @@ def run_demo(args: argparse.Namespace) -> int:
     def work() -> None:
         try:
             results.extend(demo.run(args.episodes, on_episode=_print_episode, machine_factory=lambda world: machine,
-                                    resume=None if server is None else resume))
+                                    resume=None if server is None else resume, hold=hold))
         except BaseException as exc:  # reported below, after cleanup
             failure.append(exc)
 

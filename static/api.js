@@ -54,6 +54,7 @@ export const api = {
   setInitialState: (name, path, states, userdata) =>
     request("POST", machine(name) + "/initial-state", { path, states, userdata }),
   start: (name) => request("POST", machine(name) + "/start", {}),
+  hold: (name, reason) => request("POST", machine(name) + "/hold", { reason: reason || "" }),
   streamUrl(name, since) {
     const proto = location.protocol === "https:" ? "wss:" : "ws:";
     const qs = since ? "?since=" + encodeURIComponent(since) : "";

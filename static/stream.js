@@ -10,7 +10,9 @@ const BACKOFF_MAX_MS = 4000;
 export class Stream {
   /**
    * @param {string} name machine name
-   * @param {object} handlers {snapshot(status, lastSeq), events(list), missed(count), state(state, detail)}
+   * @param {object} handlers {snapshot(status, lastSeq, history), events(list), missed(count), state(state, detail)}
+   *   history (on a new connection only, else null): {complete, events}, the current run's events
+   *   up to the snapshot, for the log (already in the snapshot's status: not to be applied again)
    * @param {object} options {url(name, since) -> ws url, checkResume(since) -> Promise<boolean>}
    *   checkResume is asked before a reconnect whether `since` still makes sense (false: the
    *   server restarted and its seqs start again, so ask for a snapshot instead).
@@ -114,7 +116,7 @@ export class Stream {
     }
     if (frame.type === "snapshot") {
       this.lastSeq = frame.last_seq ?? frame.status?.last_seq ?? 0;
-      this.handlers.snapshot(frame.status, this.lastSeq);
+      this.handlers.snapshot(frame.status, this.lastSeq, frame.history ?? null);
     } else if (frame.type === "events") {
       const fresh = [];
       for (const event of frame.events || []) {

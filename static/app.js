@@ -7,6 +7,7 @@ import { GraphView } from "./graph.js";
 import { TreeView, UserdataPanel, EventLog } from "./panels.js";
 import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
 import { SceneView } from "./scene.js";
+import { edgeId, outcomeId } from "./schema.js";
 
 const $ = (id) => document.getElementById(id);
 const MACHINE_POLL_MS = 2000;
@@ -21,7 +22,7 @@ const app = {
   selected: null,
   changed: new Map(), // container path -> Set of keys written by its last transition
   pendingChanges: new Map(), // container path -> Set of keys written since its last transition
-  lastEdge: new Map(), // container path -> e: id of its last transition
+  lastEdge: new Map(), // container path -> the edge id of its last transition
   expand: null, // null: the server's default; else a Set of container paths drawn open
   endings: new Map(), // name -> {seq, error} of the other machines that ended without an outcome
   preemptAsked: false,
@@ -255,13 +256,13 @@ function track(ev) {
     case "transition":
       app.changed.set(path, app.pendingChanges.get(path) || new Set());
       app.pendingChanges.set(path, new Set());
-      app.lastEdge.set(path, `e:${path}:${ev.from}:${ev.outcome}`);
+      app.lastEdge.set(path, edgeId(path, ev.from, ev.outcome));
       break;
     case "terminate": {
       app.changed.set(path, app.pendingChanges.get(path) || new Set());
       app.pendingChanges.set(path, new Set());
       const last = ev.last && ev.last.length === 1 ? ev.last[0] : null;
-      if (last && ev.state_outcome) app.lastEdge.set(path, `e:${path}:${last}:${ev.state_outcome}`);
+      if (last && ev.state_outcome) app.lastEdge.set(path, edgeId(path, last, ev.state_outcome));
       if (path === app.status.root_path) {
         const outcome = ev.outcome === null ? "no outcome" + (ev.error ? ` (${ev.error})` : "") : `outcome '${ev.outcome}'`;
         app.finishedText = `${app.name} finished: ${outcome}`;
@@ -286,6 +287,7 @@ function structureChanged() {
   app.structureKey = key;
   app.nodes = new Map();
   for (const node of allNodes(root)) app.nodes.set(node.path, node);
+  graph.index(app.nodes.values());
   tree.build(root);
   const all = root ? [...containers(root)] : [];
   userdata.setContainers(all);
@@ -334,8 +336,7 @@ function toggleExpand(path, isCluster) {
   if (!node || !node.container || path === app.status.root_path) return;
   if (!app.expand) {
     // From the server's default: open what it opened (clusters in the current SVG).
-    app.expand = new Set([...$("graph").querySelectorAll("g.cluster")].map((g) => g.id)
-      .filter((id) => id.startsWith("c:")).map((id) => id.slice(2)));
+    app.expand = new Set(graph.openPaths());
     app.expand.add(app.status.root_path);
   }
   if (isCluster || app.expand.has(path)) {
@@ -521,7 +522,7 @@ function render() {
   const running = Object.entries(s.containers).filter(([, c]) => c.running).map(([p]) => p);
   const reached = Object.entries(s.containers)
     .filter(([, c]) => !c.running && c.outcome !== null && c.outcome !== undefined)
-    .map(([p, c]) => `o:${p}:${c.outcome}`);
+    .map(([p, c]) => outcomeId(p, c.outcome));
   const failed = failedPaths(s);
   graph.apply({ active, running, reached, lastEdges: [...app.lastEdge.values()], failed, selected: app.selected });
   tree.update(s, failed);

@@ -1,8 +1,10 @@
 // The machine graph: the server's Graphviz SVG (one layout per structure + expand set),
 // sanitized and inlined; status only toggles CSS classes on the stable ids of docs/api.md
-// (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME), so the layout never moves when
-// only the status changes. Pan (drag) and zoom (wheel) act on the SVG's viewBox.
+// (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
+// the layout never moves when only the status changes. Pan (drag) and zoom (wheel) act on the
+// SVG's viewBox.
 
+import { containerId, outcomeId, stateId } from "./schema.js";
 import { parentPath } from "./status.js";
 
 const SVG_NS = "http://www.w3.org/2000/svg";
@@ -61,6 +63,7 @@ export class GraphView {
     this.vb = null;
     this.key = null; // what the current SVG was laid out for
     this.classed = new Map(); // class name -> Set of element ids
+    this.pathOf = new Map(); // element id -> the path of the state or container it stands for
     this.follow = true;
     this.loadToken = 0;
     this._bindPointer();
@@ -110,10 +113,27 @@ export class GraphView {
     return this.svg ? document.getElementById(id) : null;
   }
 
+  /** Learn the element ids of a structure's nodes: an id is escaped text, looked up here, never parsed. */
+  index(nodes) {
+    this.pathOf = new Map();
+    for (const node of nodes) {
+      this.pathOf.set(stateId(node.path), node.path);
+      if (!node.container) continue;
+      this.pathOf.set(containerId(node.path), node.path);
+      for (const outcome of node.outcomes) this.pathOf.set(outcomeId(node.path, outcome), node.path);
+    }
+  }
+
+  /** The paths of the containers drawn open (as clusters). */
+  openPaths() {
+    const clusters = this.svg ? [...this.svg.querySelectorAll("g.cluster")] : [];
+    return clusters.map((g) => this.pathOf.get(g.id)).filter((path) => path !== undefined);
+  }
+
   /** The element that stands for a state path: itself, or the closest collapsed ancestor. */
   stateElement(path) {
     for (let p = path; p; p = parentPath(p)) {
-      const el = this.el("s:" + p) || this.el("c:" + p);
+      const el = this.el(stateId(p)) || this.el(containerId(p));
       if (el) return el;
     }
     return null;
@@ -150,7 +170,7 @@ export class GraphView {
       if (!deepest || path.length > deepest.path.length) deepest = { path, el };
     }
     for (const path of view.running) {
-      if (this.el("c:" + path)) active.add("c:" + path);
+      if (this.el(containerId(path))) active.add(containerId(path));
     }
     this._setClass("active", active);
     this._setClass("reached", new Set(view.reached));
@@ -231,10 +251,10 @@ export class GraphView {
   _target(event) {
     const g = event.target.closest?.("g.node, g.cluster");
     if (!g || !this.svg?.contains(g)) return null;
-    const id = g.id || "";
-    if (id.startsWith("s:") || id.startsWith("c:")) return { path: id.slice(2), cluster: id.startsWith("c:"), el: g };
-    if (id.startsWith("o:")) return { path: id.slice(2, id.lastIndexOf(":")), cluster: true, el: g };
-    return null;
+    const path = this.pathOf.get(g.id);
+    if (path === undefined) return null;
+    // A cluster or a container's outcome stands for the open container (double-click closes it).
+    return { path, cluster: g.id !== stateId(path), el: g };
   }
 
   _bindPointer() {

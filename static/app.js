@@ -7,7 +7,7 @@ import { GraphView } from "./graph.js";
 import { TreeView, UserdataPanel, EventLog } from "./panels.js";
 import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
 import { SceneView } from "./scene.js";
-import { edgeId, outcomeId } from "./schema.js";
+import { CONTROLLABLE_SOURCES, SOURCES, edgeId, outcomeId } from "./schema.js";
 
 const $ = (id) => document.getElementById(id);
 const MACHINE_POLL_MS = 2000;
@@ -91,6 +91,18 @@ function currentEntry() {
   return app.machines.find((m) => m.name === app.name) || null;
 }
 
+const NOT_CONTROLLABLE = {
+  [SOURCES.ingest]: "this machine runs in another process: control it there",
+  [SOURCES.replay]: "this machine is a recording being replayed: nothing to control",
+};
+
+/** Why this page cannot control the machine of `entry` ("" when it can): the server would answer 409. */
+function controlRefusal(entry) {
+  if (!entry) return "no such machine on the server";
+  if (CONTROLLABLE_SOURCES.includes(entry.source)) return "";
+  return NOT_CONTROLLABLE[entry.source] || `a machine of source ${entry.source} cannot be controlled`;
+}
+
 async function pollMachines() {
   try {
     const list = await api.machines();
@@ -149,7 +161,7 @@ function fillPicker() {
       : { running: m.running, outcome: m.outcome, error: app.endings.get(m.name)?.error };
     const state = runState(live);
     const text = state === "done" ? "→ " + live.outcome : state;
-    return [m.name, `${m.name}  (${text}${m.source === "ingest" ? ", remote" : ""})`];
+    return [m.name, `${m.name}  (${text}${m.source === SOURCES.ingest ? ", remote" : ""})`];
   });
   if (labels.map(([v, t]) => v + "\u0000" + t).join("\u0001") === have) return;
   picker.replaceChildren(...labels.map(([value, text]) => {
@@ -386,13 +398,13 @@ function stateMenu(path, x, y) {
   const container = parentPath(path);
   const parent = container ? app.nodes.get(container) : null;
   select(path);
-  const local = currentEntry()?.source !== "ingest";
+  const refusal = controlRefusal(currentEntry());
   const takesInitial = parent && parent.type !== "Concurrence" && parent.type !== "Iterator";
   showMenu(x, y, path, [
     {
       label: "Set as initial state…",
-      disabled: !node || !parent || !local || !takesInitial,
-      title: !parent ? "the root has no parent container" : !takesInitial ? `a ${parent.type} has no initial state to choose` : "",
+      disabled: !node || !parent || !takesInitial || Boolean(refusal),
+      title: !parent ? "the root has no parent container" : !takesInitial ? `a ${parent.type} has no initial state to choose` : refusal,
       action: () => setInitial(container, node.label),
     },
     { label: node && node.container ? "Show userdata" : "Show container userdata", action: () => {
@@ -449,9 +461,9 @@ function updateControls() {
   const entry = currentEntry();
   const running = app.status ? app.status.running : false;
   const live = app.online && app.stream?.state === "live";
-  // Only a machine of the serving process can be controlled (not another process's, not a replay).
-  $("preempt-btn").disabled = !live || !running || entry?.source !== "local";
-  $("start-btn").disabled = !live || running || !entry || !entry.can_start;
+  const controllable = !controlRefusal(entry);
+  $("preempt-btn").disabled = !live || !running || !controllable;
+  $("start-btn").disabled = !live || running || !controllable || !entry.can_start;
   const pill = $("run-state");
   const s = app.status;
   const state = s?.structure ? runState(s) : "idle";
@@ -476,7 +488,7 @@ function updateBadge() {
     const rate = stream.rate();
     const lat = stream.latencyMs;
     const shownRate = rate < 10 ? rate.toFixed(1) : Math.round(rate);
-    if (currentEntry()?.source === "replay") {
+    if (currentEntry()?.source === SOURCES.replay) {
       text = `replay · ${shownRate} ev/s`; // a recording's timestamps say nothing of latency
     } else {
       text = `live · ${shownRate} ev/s · ${lat === null ? "–" : lat < 10 ? lat.toFixed(1) : Math.round(lat)} ms`;

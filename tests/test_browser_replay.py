@@ -51,18 +51,34 @@ def replay_url(tmp_path):
         proc.wait(20)
 
 
-@pytest.mark.timeout(60)
-def test_a_replayed_run_plays_in_the_dashboard_as_a_view_only_replay(replay_url):
+@pytest.fixture
+def replay_page(replay_url):
+    """The dashboard watching the replay (which starts when it connects)."""
     playwright_api = pytest.importorskip("playwright.sync_api")
     with playwright_api.sync_playwright() as pw:
         browser = launch_chromium(pw)
         page = open_page(browser, replay_url)
-        seen = set()
-        deadline = time.monotonic() + 10
-        while time.monotonic() < deadline and not {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen:
-            seen.add(page.evaluate(ACTIVE_LEAF))
-            time.sleep(0.05)
-        assert {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen, seen
-        assert page.text_content("#badge .badge-text").startswith("replay")
-        assert page.is_disabled("#preempt-btn")
+        yield page
+        assert not page.errors
         browser.close()
+
+
+@pytest.mark.timeout(60)
+def test_a_replayed_run_plays_in_the_dashboard_as_a_view_only_replay(replay_page):
+    seen = set()
+    deadline = time.monotonic() + 10
+    while time.monotonic() < deadline and not {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen:
+        seen.add(replay_page.evaluate(ACTIVE_LEAF))
+        time.sleep(0.05)
+    assert {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen, seen
+    assert replay_page.text_content("#badge .badge-text").startswith("replay")
+    assert replay_page.is_disabled("#preempt-btn")
+
+
+@pytest.mark.timeout(60)
+def test_a_replayed_machine_offers_no_initial_state_and_says_why(replay_page):
+    replay_page.wait_for_selector("#badge.live")
+    replay_page.click('.tree-row[data-path="/SM_ROOT/B"] .label', button="right")
+    item = replay_page.locator("#menu button", has_text="Set as initial state")
+    assert item.is_disabled()
+    assert "replay" in item.get_attribute("title")

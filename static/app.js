@@ -52,7 +52,7 @@ const userdata = new UserdataPanel($("userdata"), $("ud-container"), {
   redraw: () => queueRender(),
 });
 const log = new EventLog($("log"), {
-  kinds: $("log-kinds"), text: $("log-filter"), count: $("log-count"), clear: $("log-clear"),
+  kinds: $("log-kinds"), text: $("log-filter"), count: $("log-count"), clear: $("log-clear"), partial: $("log-partial"),
 }, { select: (path) => select(path) });
 log.nodeOf = (path) => app.nodes.get(path);
 const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"));
@@ -216,10 +216,11 @@ function openMachine(name) {
 
 // ---------------------------------------------------------------- stream handling
 
-function onSnapshot(status) {
+function onSnapshot(status, lastSeq, history) {
   app.status = Status.fromDict({ machine: app.name, ...status });
   forgetRunMarks();
   structureChanged();
+  if (history) log.history(history); // a new connection: the run so far, for the log only (the status has it)
   queueRender();
 }
 

@@ -251,7 +251,8 @@ class KindFilter {
 export class EventLog {
   constructor(host, controls, handlers) {
     this.host = host;
-    this.controls = controls; // {kinds: <details> of checkboxes, text: input, count: element, clear: button}
+    // {kinds: <details> of checkboxes, text: input, count: element, clear: button, partial: the note on a history cut short}
+    this.controls = controls;
     this.handlers = handlers;
     this.events = [];
     this.shown = 0; // how many of this.events pass the filters
@@ -266,7 +267,7 @@ export class EventLog {
     this.selectedRow = null;
     this.kinds = new KindFilter(controls.kinds, () => this.redraw());
     controls.text.addEventListener("input", () => this.redraw());
-    controls.clear.addEventListener("click", () => { this.events = []; this.redraw(); });
+    controls.clear.addEventListener("click", () => this.reset());
     host.addEventListener("click", (e) => {
       const row = e.target.closest(".log-row");
       if (!row) return;
@@ -279,7 +280,21 @@ export class EventLog {
 
   reset() {
     this.events = [];
+    this.controls.partial.hidden = true;
     this.redraw();
+  }
+
+  /** A new connection's history: the current run's events up to its snapshot; `complete` false when
+   * the server no longer keeps the run's earliest events. */
+  history({ complete, events }) {
+    this.add(events);
+    this.redraw(); // all its rows at once, not only the newest of one frame
+    const note = this.controls.partial;
+    note.hidden = complete;
+    if (!complete) {
+      const from = events.length ? ` (the log starts at event ${events[0].seq})` : "";
+      note.textContent = `Earlier events of this run are not kept by the server${from}.`;
+    }
   }
 
   /** An event's transcript line and searched text, worked out once (the filter and the row both need them). */

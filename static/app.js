@@ -7,6 +7,7 @@ import { GraphView } from "./graph.js";
 import { TreeView, UserdataPanel, EventLog } from "./panels.js";
 import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
 import { SceneView } from "./scene.js";
+import { overduePreemptText } from "./preempt.js";
 import { CONTROLLABLE_SOURCES, SOURCES, edgeId, outcomeId } from "./schema.js";
 
 const $ = (id) => document.getElementById(id);
@@ -28,6 +29,7 @@ const app = {
   preemptAsked: false,
   preemptAck: null,
   finishedText: null, // "NAME finished: outcome 'X'" once the root terminated, until it starts again
+  overdueText: null, // the notice naming the states that have not serviced a preempt, while shown
   renderQueued: false,
   online: true,
 };
@@ -191,6 +193,7 @@ function openMachine(name) {
   app.preemptAsked = false;
   app.preemptAck = null;
   app.finishedText = null;
+  app.overdueText = null;
   graph.clear("Waiting for the machine's structure…");
   tree.build(null);
   userdata.show(null);
@@ -447,6 +450,17 @@ $("preempt-btn").addEventListener("click", async () => {
     notice("Preempt failed: " + (err.detail || err.message), "error", true);
   }
 });
+
+/** Name the states that have not serviced a preempt requested a while ago, counting the seconds; take
+ * it back when that no longer holds (unless another notice, such as the outcome, has replaced it). */
+function sayOverduePreempt() {
+  const text = app.status ? overduePreemptText(app.status, Date.now() / 1000) : null;
+  if (text === app.overdueText) return;
+  if (text) notice(text, "warn", true);
+  else if ($("notice").textContent === app.overdueText) clearNotice();
+  app.overdueText = text;
+}
+setInterval(sayOverduePreempt, 500);
 
 $("start-btn").addEventListener("click", async () => {
   const name = app.name;

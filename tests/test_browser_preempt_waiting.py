@@ -1,0 +1,69 @@
+"""A preempt that a state never services: after a few seconds the page names the state and counts
+the seconds since the preempt was requested, instead of "waiting for the outcome" forever."""
+
+from __future__ import annotations
+
+import re
+import threading
+
+import fsm
+import pytest
+from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from server.introspection_server import ServerThread
+
+OVERDUE = re.compile(r"^Preempt requested (\d+) s ago: /SM_ROOT/STUBBORN has not serviced it$")
+
+
+class Stubborn(fsm.State):
+    """Ignores preemption and runs until released."""
+
+    def __init__(self):
+        fsm.State.__init__(self, outcomes=["done"])
+        self.release = threading.Event()
+
+    def execute(self, ud):
+        self.release.wait(60)
+        return "done"
+
+
+@pytest.fixture(scope="module")
+def preempted(browser):  # noqa: F811
+    """A page that preempted a machine whose only state ignores it."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    stubborn = Stubborn()
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("STUBBORN", stubborn, {"done": "done"})
+    srv = ServerThread().start()
+    srv.hub.add_local(sm, name="stubborn")
+    runner = threading.Thread(target=sm.execute)
+    runner.start()
+    try:
+        page = watch(browser, srv, "stubborn")
+        page.wait_for_selector("#run-state.running")
+        page.click("#preempt-btn")
+        page.click("#preempt-confirm")
+        page.wait_for_selector("#notice:has-text('Preempt accepted')")
+        yield page
+        assert not page.errors
+    finally:
+        stubborn.release.set()
+        runner.join(10)
+        srv.stop()
+
+
+def overdue_seconds(page) -> int:
+    """The seconds the notice says the preempt has waited, once it says so."""
+    page.wait_for_function("re => new RegExp(re).test(document.getElementById('notice').textContent)",
+                           arg=OVERDUE.pattern, timeout=10000)
+    return int(OVERDUE.match(page.text_content("#notice")).group(1))
+
+
+def test_a_preempt_not_serviced_after_3_s_names_the_state_that_has_not_serviced_it(preempted):
+    assert overdue_seconds(preempted) >= 3
+
+
+def test_the_seconds_since_the_preempt_was_requested_keep_counting(preempted):
+    before = overdue_seconds(preempted)
+    preempted.wait_for_function("text => document.getElementById('notice').textContent.includes(text)",
+                                arg="requested %d s ago" % (before + 1))

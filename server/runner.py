@@ -52,6 +52,7 @@ class Runner:
     machines: list[Machine] = field(default_factory=list)
     recorder: Recorder | None = None
     keep_open: bool = False  # leave the log open when the script ends, until close()
+    signalled: int | None = None  # the signal (SIGINT, SIGTERM) that ended the script, if one did
 
     def __post_init__(self) -> None:
         self.stem = os.path.splitext(os.path.basename(self.script))[0]
@@ -89,7 +90,7 @@ class Runner:
             sys.path[0] = os.path.dirname(script)
         else:
             sys.path.insert(0, os.path.dirname(script))
-        self._restore_sigterm = _sigterm_as_exit()
+        self._restore_sigterm = _sigterm_as_exit(self._note_signal)
         fsm.add_global_hook(self._hook)
         code = 0
         try:
@@ -97,6 +98,7 @@ class Runner:
         except SystemExit as exc:
             code = _exit_code(exc.code)
         except KeyboardInterrupt:
+            self._note_signal(signal.SIGINT)
             code = 130
         except BaseException:
             traceback.print_exc()
@@ -109,6 +111,9 @@ class Runner:
             if not self.keep_open:
                 self.close()
         return code
+
+    def _note_signal(self, signum: int) -> None:
+        self.signalled = signum
 
     def close(self) -> None:
         """Close the log (write, fsync) and say what it holds; idempotent."""
@@ -130,12 +135,14 @@ def _exit_code(code: Any) -> int:
     return 1
 
 
-def _sigterm_as_exit() -> Callable[[], None]:
-    """Turn SIGTERM into SystemExit (so the log is closed) unless the script handles it itself."""
+def _sigterm_as_exit(noted: Callable[[int], None]) -> Callable[[], None]:
+    """Turn SIGTERM into SystemExit (so the log is closed) unless the script handles it itself;
+    ``noted`` hears of it first, whatever the script then makes of the SystemExit."""
     if threading.current_thread() is not threading.main_thread() or signal.getsignal(signal.SIGTERM) != signal.SIG_DFL:
         return lambda: None
 
     def on_sigterm(signum: int, frame: Any) -> None:
+        noted(signum)
         raise SystemExit(128 + signum)
 
     signal.signal(signal.SIGTERM, on_sigterm)

@@ -51,7 +51,8 @@ def serve(args: argparse.Namespace) -> int:
 
 
 def run_with_dashboard(args: argparse.Namespace, runner: Any) -> int:
-    """``fsmscope run``: serve every machine the script runs; keep serving afterwards unless --exit."""
+    """``fsmscope run``: serve every machine the script runs; keep serving afterwards unless --exit,
+    or unless a signal (Ctrl-C, SIGTERM) ended the script: one signal stops everything."""
     try:
         srv = start_server(args)
     except (ValueError, OSError) as exc:
@@ -63,7 +64,7 @@ def run_with_dashboard(args: argparse.Namespace, runner: Any) -> int:
     print("fsmscope: dashboard at %s" % srv.url, file=sys.stderr, flush=True)
     try:
         code = runner.run()
-        if not args.exit:
+        if not args.exit and runner.signalled is None:
             print("fsmscope: the script ended (exit code %d); still serving at %s (Ctrl-C stops)"
                   % (code, srv.url), file=sys.stderr, flush=True)
             wait_for_interrupt()

@@ -194,6 +194,46 @@ def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(
     assert summary["machines"]["foo_bar"]["runs"] == 2 and summary["machines"]["foo_bar"]["outcome"] == "end"
 
 
+SLEEPING_SCRIPT = """
+import time
+import fsm as smach
+
+class Sleep(smach.State):
+    def __init__(self):
+        smach.State.__init__(self, outcomes=["done"])
+
+    def execute(self, ud):
+        print("sleeping", flush=True)
+        time.sleep(60)
+        return "done"
+
+sm = smach.StateMachine(["done"])
+with sm:
+    smach.StateMachine.add("SLEEP", Sleep(), {"done": "done"})
+sm.execute()
+"""
+
+
+@pytest.mark.parametrize("signum, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)], ids=["SIGTERM", "SIGINT"])
+def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, signum, code):
+    script = tmp_path / "sleepy.py"
+    script.write_text(SLEEPING_SCRIPT)
+    log = tmp_path / "sleepy.jsonl"
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "run", str(script), "--record", str(log)],
+                            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
+    try:
+        assert "sleeping\n" in proc.stdout  # reads the script's output up to the line (the machine is in SLEEP)
+        proc.send_signal(signum)
+        assert proc.wait(10) == code  # not still serving the dashboard
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    last = json.loads(log.read_bytes().splitlines()[-1])
+    assert (last["kind"], last["path"]) == ("terminate", "/SM_ROOT")
+    assert json.loads(cli("replay", log, "--json").stdout)["problems"] == []
+
+
 def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_log):
     proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve",
                              "--speed", "0", "--token", "replay-token"],

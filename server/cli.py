@@ -177,12 +177,23 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
+    """For a subcommand that passes arguments on (to a script): its own arguments, and those after
+    the first '--', as they are. argparse cannot be left to it: it keeps that '--' among the
+    unknown arguments or drops it, depending on what precedes it (and on the Python version)."""
+    if argv and argv[0] in SUBCOMMANDS and SUBCOMMANDS[argv[0]].extra_args and "--" in argv:
+        cut = argv.index("--")
+        return argv[:cut], argv[cut + 1:]
+    return argv, []
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args, extra = parser.parse_known_args(argv)
+    own, passed_on = _split_passed_on(sys.argv[1:] if argv is None else list(argv))
+    args, extra = parser.parse_known_args(own)
     if extra and not SUBCOMMANDS[args.command].extra_args:
         parser.error("unrecognized arguments: %s" % " ".join(extra))
-    args.extra = extra
+    args.extra = extra + passed_on
     try:
         return SUBCOMMANDS[args.command].handler(args)
     except BrokenPipeError:  # `fsmscope replay run.jsonl | head`

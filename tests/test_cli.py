@@ -44,6 +44,14 @@ def test_run_passes_unknown_arguments_to_the_script(tmp_path):
     assert counts and counts == [line for line in again.stdout.splitlines() if line.startswith("A_count=")]
 
 
+def test_run_passes_the_arguments_after_a_double_dash_to_the_script_without_it(tmp_path):
+    script = tmp_path / "argv.py"
+    script.write_text("import json, sys\nprint(json.dumps(sys.argv[1:]))\n")
+    done = cli("run", script, "--record", tmp_path / "r.jsonl", "--", "--runs", "3")
+    assert done.returncode == 0, done.stderr
+    assert json.loads(done.stdout.splitlines()[-1]) == ["--runs", "3"]
+
+
 def test_run_names_a_second_machine_after_the_script_with_a_number(tmp_path):
     script = tmp_path / "twice.py"
     script.write_text("import runpy, sys\nsys.path.insert(0, %r)\nfrom foo_bar import build\n"

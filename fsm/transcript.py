@@ -8,18 +8,24 @@ printed as they were logged.
 A line reads ``12:34:56.789 /SM_ROOT/SUB [  INFO ] : State machine transitioning 'A':'done'-->'B'``:
 everything from the level prefix on is exactly what SMACH would have printed. Once a log
 holds more than one machine, the path is prefixed with the machine's name (``foo_bar:/SM_ROOT``).
+
+SMACH had no operator controls: a ``control`` event (preempt, initial-state, start, publish from
+the dashboard) reads word for word as the browser's transcript (static/transcript.js) writes it.
 """
 
 from __future__ import annotations
 
+import json
 import time
 from dataclasses import dataclass
-from typing import Iterable, Iterator
+from decimal import Decimal
+from typing import Any, Iterable, Iterator
 
 from .structure_index import StructureIndex
 
 PREFIXES = {"info": "[  INFO ] : ", "warn": "[  WARN ] : ", "debug": "[ DEBUG ] : ", "error": "[ ERROR ] : "}
 SERVICED_PREEMPT = "Concurrence serviced preempt."
+CONTROL_PARAMS_LIMIT = 120  # characters of a control's params shown, as in the browser
 
 
 @dataclass(frozen=True)
@@ -59,6 +65,8 @@ class Transcript:
             if event.get("msg") == SERVICED_PREEMPT:
                 self._serviced.add((event["machine"], event["path"]))
             return [(event.get("level", "info"), str(event.get("msg", "")))]
+        if kind == "control":
+            return [control_message(event)]
         if kind not in ("start", "transition", "terminate"):
             return []
         ctype = self.structures.container_type(event)
@@ -98,6 +106,81 @@ class Transcript:
         where = line.path if len(self.machines) < 2 else "%s:%s" % (line.machine, line.path)
         text = "%s %s%s" % (where, PREFIXES.get(line.level, PREFIXES["info"]), line.msg)
         return "%s %s" % (format_time(line.t), text) if with_time else text
+
+
+def control_message(event: dict) -> tuple[str, str]:
+    """(level, text) of a control event, as static/transcript.js words it: the operator's action
+    reads the same in a headless replay as in the dashboard."""
+    accepted = event.get("result") == "accepted"
+    params = " " + value_text(event["params"], CONTROL_PARAMS_LIMIT) if event.get("params") else ""
+    reason = " (%s)" % event["reason"] if event.get("reason") else ""
+    result = "accepted" if accepted else "refused: %s" % event.get("result")
+    return ("info" if accepted else "warn", "Control %s%s from %s%s: %s" % (
+        _coalesce(event.get("action"), "?"), params, _coalesce(event.get("client"), "?"), reason, result))
+
+
+def _coalesce(value: Any, default: Any) -> Any:
+    """JavaScript's ``value ?? default``."""
+    return default if value is None else value
+
+
+def value_text(value: Any, limit: int = 200) -> str:
+    """static/transcript.js's valueText: an encoded value (docs/events.md) on one line, cut after
+    ``limit`` characters as JavaScript counts them."""
+    if isinstance(value, dict) and isinstance(value.get("$repr"), str):
+        text = value["$repr"]
+    elif isinstance(value, dict) and value.get("$truncated"):
+        text = "%s… (%s bytes, truncated)" % (_coalesce(value.get("repr"), ""), js_json(value.get("size")))
+    else:
+        text = js_json(value)
+    units = text.encode("utf-16-le", "surrogatepass")  # JavaScript's length counts UTF-16 units
+    if len(units) <= 2 * limit:
+        return text
+    return units[:2 * limit].decode("utf-16-le", "replace") + "…"  # half a pair: U+FFFD, as the browser draws it
+
+
+def js_json(value: Any) -> str:
+    """JSON.stringify of a JSON value: compact, non-ASCII as is, numbers and key order as in
+    JavaScript (so that a line reads the same here and in the browser)."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (int, float)):
+        return _js_number(value)
+    if isinstance(value, str):
+        return json.dumps(value, ensure_ascii=False)
+    if isinstance(value, dict):
+        return "{%s}" % ",".join("%s:%s" % (json.dumps(key, ensure_ascii=False), js_json(value[key]))
+                                 for key in _js_key_order(value))
+    return "[%s]" % ",".join(map(js_json, value))
+
+
+def _js_number(value: float) -> str:
+    """Number#toString: the shortest digits that read back as the same double (those of Python's
+    repr), written plainly from 1e-7 to 1e21 and with an exponent outside; an integer is a double."""
+    x = float(value)
+    if x == 0:
+        return "0"
+    _, digits, exponent = Decimal(repr(abs(x))).normalize().as_tuple()
+    s, k = "".join(map(str, digits)), len(digits)
+    n = k + exponent  # x = 0.s * 10**n
+    if k <= n <= 21:
+        text = s + "0" * (n - k)
+    elif 0 < n <= 21:
+        text = s[:n] + "." + s[n:]
+    elif -6 < n <= 0:
+        text = "0." + "0" * -n + s
+    else:
+        text = s[0] + ("." + s[1:] if k > 1 else "") + "e%+d" % (n - 1)
+    return "-" + text if x < 0 else text
+
+
+def _js_key_order(obj: dict) -> list[str]:
+    """A JavaScript object's key order: array indices ("0", "7", ...) ascending, then the rest as inserted."""
+    def is_index(key: str) -> bool:
+        return key.isascii() and key.isdigit() and (key == "0" or key[0] != "0") and int(key) < 2 ** 32 - 1
+    return sorted(filter(is_index, obj), key=int) + [key for key in obj if not is_index(key)]
 
 
 _second: list = [None, ""]  # the last whole second formatted, and its text

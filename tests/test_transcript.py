@@ -1,6 +1,7 @@
 """fsm.transcript: the replayed lines are the lines SMACH printed live, word for word."""
 
 import fsm
+import pytest
 from fsm.log_reader import read_events
 from fsm.transcript import Transcript, messages, transcript
 
@@ -68,3 +69,45 @@ def test_log_events_keep_their_level(tmp_path, logs):
         return "done"
     record(machine(["done"], [("A", Out(warn, outcomes=["done"]), {})]), path)
     assert ("warn", "careful") in _replayed(path)
+
+
+def _control(action, result="accepted", reason=None, params=None, client="127.0.0.1"):
+    return {"v": 1, "seq": 1, "t": 0.0, "run": "r", "machine": "m", "kind": "control", "path": "/SM_ROOT",
+            "action": action, "reason": reason, "client": client, "result": result, "params": params or {}}
+
+
+def _control_line(event):
+    [line] = Transcript().lines(event)
+    return line.level, line.msg
+
+
+# The expected texts follow static/transcript.js for a control event:
+# `Control ${action}${params} from ${client}${reason}: ${result}`.
+@pytest.mark.parametrize("event, expected", [
+    (_control("preempt", reason="operator"), ("info", "Control preempt from 127.0.0.1 (operator): accepted")),
+    (_control("preempt", result="not running"), ("warn", "Control preempt from 127.0.0.1: refused: not running")),
+    (_control("start", client="10.0.0.7"), ("info", "Control start from 10.0.0.7: accepted")),
+    (_control("publish", params={"topic": "sm_stop", "delivered": 1}),
+     ("info", 'Control publish {"topic":"sm_stop","delivered":1} from 127.0.0.1: accepted')),
+    (_control("initial-state", result="no state 'X' in /SM_ROOT", params={"states": ["X"], "userdata": {}}),
+     ("warn", 'Control initial-state {"states":["X"],"userdata":{}} from 127.0.0.1: refused: no state \'X\' in /SM_ROOT')),
+], ids=["preempt", "refused", "start", "publish", "initial-state"])
+def test_a_control_event_reads_as_the_browser_writes_it(event, expected):
+    assert _control_line(event) == expected
+
+
+def test_control_params_are_written_as_javascripts_json_stringify_writes_them():
+    params = {"speed": 1.0, "tiny": 1e-7, "huge": 1e21, "big": 12345678901234567890, "name": "café", "b": 1, "2": 2}
+    assert _control_line(_control("initial-state", params=params))[1] == (
+        'Control initial-state {"2":2,"speed":1,"tiny":1e-7,"huge":1e+21,"big":12345678901234567000,"name":"café",'
+        '"b":1} from 127.0.0.1: accepted')
+
+
+def test_long_control_params_are_cut_at_120_characters_with_an_ellipsis():
+    text = _control_line(_control("initial-state", params={"states": ["S" * 200]}))[1]
+    assert text == 'Control initial-state {"states":["' + "S" * 108 + '… from 127.0.0.1: accepted'
+
+
+def test_the_cut_counts_characters_as_javascript_does_two_for_an_emoji():
+    text = _control_line(_control("initial-state", params={"states": ["\U0001F600" * 100]}))[1]
+    assert text == 'Control initial-state {"states":["' + "\U0001F600" * 54 + '… from 127.0.0.1: accepted'

@@ -5,6 +5,8 @@ and gives a JSON-safe dict (``to_dict``) or a text table (``format``). A state i
 from the event that makes it active (its container's ``start``, or the ``transition`` to
 it) to the event that ends it (the ``transition`` from it, or its container's
 ``terminate``); a visit still open when the log ends counts as a visit without a time.
+A machine's duration is the time its runs took (root ``start`` to root ``terminate``; a run
+still open when the log ends, to its last event); the idle time between runs is apart.
 """
 
 from __future__ import annotations
@@ -38,6 +40,31 @@ class _Machine:
         self.preempts = {"requested": 0, "serviced": 0}
         self.feedback = 0
         self.controls: list[dict] = []
+        self.run_time = 0.0  # of the runs that ended
+        self.run_start: float | None = None  # when the open run started
+        self.run_end: float | None = None  # when the last run ended
+        self.idle = 0.0  # between runs
+
+    def start_run(self, t: float | None) -> None:
+        if self.run_start is not None:  # the log never ended the run before: it ends at its last event
+            self.end_run(self.last_t)
+        if self.run_end is not None and t is not None:
+            self.idle += max(0.0, t - self.run_end)
+        self.runs += 1
+        self.run_start = t
+
+    def end_run(self, t: float | None) -> None:
+        if self.run_start is not None and t is not None:
+            self.run_time += max(0.0, t - self.run_start)
+        self.run_start, self.run_end = None, t
+
+    def duration(self) -> float | None:
+        """Seconds of running, a run still open counting to the last event; None before any run."""
+        if not self.runs:
+            return None
+        if self.run_start is None or self.last_t is None:
+            return self.run_time
+        return self.run_time + max(0.0, self.last_t - self.run_start)
 
     def enter(self, path: str, label: str, t: float | None) -> None:
         self.entered.setdefault(path, {})[label] = t
@@ -88,7 +115,6 @@ class Summary:
         t = event.get("t")
         if m.first_t is None:
             m.first_t = t
-        m.last_t = t
         path = event["path"]
         if kind == "structure":
             if self._own_structures:
@@ -97,7 +123,7 @@ class Summary:
         elif kind == "start":
             if path == m.root_path or m.root_path is None:
                 m.root_path = path
-                m.runs += 1
+                m.start_run(t)
                 m.status, m.outcome, m.ended_with_error = INCOMPLETE, None, None
             m.leave_all(path, t)
             m.sync(path, list(event.get("active") or []), t)
@@ -116,6 +142,7 @@ class Summary:
                 key = (path, str(last[0]), str(event.get("state_outcome", outcome)), str(outcome))
                 m.transitions[key] = m.transitions.get(key, 0) + 1
             if path == m.root_path:
+                m.end_run(t)
                 m.outcome = outcome
                 m.status = FINISHED if outcome is not None else ERROR
                 m.ended_with_error = event.get("error")
@@ -130,6 +157,7 @@ class Summary:
             m.feedback += 1
         elif kind == "control":
             m.controls.append({k: event.get(k) for k in ("t", "action", "reason", "client", "result")})
+        m.last_t = t  # after the event: a run it starts closes one left open at the event before
 
     def add_all(self, events: Iterable[dict]) -> Summary:
         for event in events:
@@ -156,7 +184,7 @@ class Summary:
             machines[name] = {
                 "status": m.status, "outcome": m.outcome, "error": m.ended_with_error, "runs": m.runs,
                 "events": m.events, "started": m.first_t, "ended": m.last_t,
-                "duration": (m.last_t - m.first_t) if m.first_t is not None and m.last_t is not None else None,
+                "duration": m.duration(), "idle": m.idle,
                 "states": states,
                 "transitions": [{"path": p, "from": f, "outcome": o, "to": to, "count": c}
                                 for (p, f, o, to), c in m.transitions.items()],
@@ -176,9 +204,10 @@ class Summary:
                 head = "ended in an error: %s" % (m["error"] or "no outcome")
             else:
                 head = "did not finish (the log ends while it runs)"
-            duration = "" if m["duration"] is None else " after %.3f s" % m["duration"]
-            out.append("machine %s: %s%s (%d run%s, %d events)"
-                       % (name, head, duration, m["runs"], "" if m["runs"] == 1 else "s", m["events"]))
+            duration = "" if m["duration"] is None else " after %.3f s running" % m["duration"]
+            idle = ", %.3f s idle between runs" % m["idle"] if m["runs"] > 1 else ""
+            out.append("machine %s: %s%s (%d run%s, %d events%s)"
+                       % (name, head, duration, m["runs"], "" if m["runs"] == 1 else "s", m["events"], idle))
             if m["states"]:
                 width = max(len("state"), *(len(s) for s in m["states"]))
                 out.append("  %-*s %7s %10s %10s %10s" % (width, "state", "visits", "total s", "median s", "max s"))

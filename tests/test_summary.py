@@ -27,6 +27,14 @@ def _timed_run():
             _ev(6, 6.5, "terminate", last=["B"], outcome="done", active=[])]
 
 
+def _two_runs_100_s_apart():
+    """The timed run (0 to 6.5 s), 100 s of nothing, then a second run from 106.5 to 108 s."""
+    return _timed_run() + [
+        _ev(7, 106.5, "start", initial=["A"], active=["A"], userdata={}),
+        _ev(8, 107.0, "transition", **{"from": "A", "outcome": "go", "to": "B", "active": ["B"]}),
+        _ev(9, 108.0, "terminate", last=["B"], outcome="done", active=[])]
+
+
 def test_foo_bar_counts_visits_and_transitions(tmp_path):
     path = tmp_path / "run.jsonl"
     record(load_example("foo_bar")["build"](), path)
@@ -75,3 +83,19 @@ def test_the_text_summary_names_outcome_states_and_transitions():
     text = summarize(_timed_run()).format()
     assert "machine m: finished with outcome 'done'" in text
     assert "/SM_ROOT/A" in text and "A --go--> B  x2" in text and "errors: none" in text
+
+
+def test_duration_is_the_time_the_runs_took_and_the_idle_time_between_them_is_apart():
+    m = summarize(_two_runs_100_s_apart()).to_dict()["machines"]["m"]
+    assert (m["runs"], m["duration"], m["idle"]) == (2, 8.0, 100.0)
+
+
+def test_a_run_still_open_when_the_log_ends_counts_until_its_last_event():
+    m = summarize(_two_runs_100_s_apart()[:-1]).to_dict()["machines"]["m"]
+    assert (m["status"], m["duration"], m["idle"]) == (INCOMPLETE, 7.0, 100.0)
+
+
+def test_the_text_summary_gives_the_running_time_and_the_idle_time_between_runs():
+    text = summarize(_two_runs_100_s_apart()).format()
+    assert "machine m: finished with outcome 'done' after 8.000 s running (2 runs, 9 events, " \
+           "100.000 s idle between runs)" in text

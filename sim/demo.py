@@ -275,7 +275,7 @@ def run_demo(args: argparse.Namespace) -> int:
     if failure:
         raise failure[0]
     if interrupted:
-        return 130
+        return 128 + interrupted[0]  # as a shell reports a process ended by that signal: 130 Ctrl-C, 143 SIGTERM
     return 0 if results and all(r["outcome"] == "succeeded" for r in results) else 1
 
 

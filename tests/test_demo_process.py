@@ -39,7 +39,7 @@ def test_a_signal_stops_the_demo_with_its_log_closed_and_complete(tmp_path, sign
     wait_until_running(record)
     os.killpg(proc.pid, signum)
     output, _ = proc.communicate(timeout=30)
-    assert proc.returncode == 130, output
+    assert proc.returncode == 128 + signum, output
     assert re.search(r"\d+ episode\(s\) recorded to ", output)
     replay = subprocess.run(FSMSCOPE + ["replay", str(record), "--json"], cwd=ROOT, capture_output=True, text=True)
     assert replay.returncode == 0, replay.stdout + replay.stderr  # every run ended with an outcome

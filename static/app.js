@@ -8,6 +8,7 @@ import { TreeView, UserdataPanel, EventLog } from "./panels.js";
 import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
 import { SceneView } from "./scene.js";
 import { overduePreemptText } from "./preempt.js";
+import { heldText, holdChange } from "./loop.js";
 import { CONTROLLABLE_SOURCES, SOURCES, edgeId, outcomeId } from "./schema.js";
 
 const $ = (id) => document.getElementById(id);
@@ -28,6 +29,7 @@ const app = {
   endings: new Map(), // name -> {seq, error} of the other machines that ended without an outcome
   preemptAsked: false,
   preemptAck: null,
+  heldBy: null, // the seq of a preempt that came between two runs and held the loop (no outcome follows)
   finishedText: null, // "NAME finished: outcome 'X'" once the root terminated, until it starts again
   overdueText: null, // the notice naming the states that have not serviced a preempt, while shown
   renderQueued: false,
@@ -65,6 +67,7 @@ let noticeTimer = null;
 function notice(text, level = "info", sticky = false) {
   const el = $("notice");
   el.textContent = text;
+  el.title = text; // the whole of it, when the top bar leaves it too little room
   el.className = "notice " + level;
   clearTimeout(noticeTimer);
   if (!sticky) noticeTimer = setTimeout(clearNotice, 8000);
@@ -72,7 +75,7 @@ function notice(text, level = "info", sticky = false) {
 
 function clearNotice() {
   clearTimeout(noticeTimer);
-  $("notice").textContent = "";
+  $("notice").textContent = $("notice").title = "";
   $("notice").className = "notice";
 }
 
@@ -192,6 +195,7 @@ function openMachine(name) {
   clearNotice();
   app.preemptAsked = false;
   app.preemptAck = null;
+  app.heldBy = null;
   app.finishedText = null;
   app.overdueText = null;
   graph.clear("Waiting for the machine's structure…");
@@ -292,7 +296,24 @@ function track(ev) {
     case "error":
       notice(`${ev.exc_type}: ${ev.message}`, "error", true);
       break;
+    case "control":
+      loopHeld(ev);
+      break;
     default:
+  }
+}
+
+/** A hold seen on the stream, shown at once. A preempt that came between two runs held the loop:
+ * no outcome will come, the loop waits for Start. */
+function loopHeld(ev) {
+  const held = holdChange(ev);
+  const entry = currentEntry();
+  if (held === null || !entry?.can_hold) return;
+  entry.held = held; // what the next poll of /api/machines will say
+  if (held && ev.action === "preempt") {
+    app.preemptAsked = false;
+    app.heldBy = ev.seq;
+    notice(`Preempt accepted (event ${ev.seq}) between two runs: the loop waits for Start`, "warn", true);
   }
 }
 
@@ -440,7 +461,7 @@ $("preempt-btn").addEventListener("click", async () => {
   app.finishedText = null;
   try {
     const ack = await api.preempt(name, answer.reason);
-    if (name !== app.name) return;
+    if (name !== app.name || ack.seq === app.heldBy) return; // the stream has told what it did
     // The outcome may have arrived on the stream before this answer did.
     app.preemptAck = `Preempt accepted (event ${ack.seq})`;
     notice(app.preemptAck + ": " + (app.finishedText || "waiting for the outcome…"), "warn", true);
@@ -462,15 +483,19 @@ function sayOverduePreempt() {
 }
 setInterval(sayOverduePreempt, 500);
 
-$("start-btn").addEventListener("click", async () => {
+/** Ask the server for `what` by `call(name)`; a notice says how it answered. */
+async function ask(what, call, then = "") {
   const name = app.name;
   try {
-    const ack = await api.start(name);
-    noticeAbout(name, `Start accepted (event ${ack.seq})`, "ok");
+    const ack = await call(name);
+    noticeAbout(name, `${what} accepted (event ${ack.seq})${then}`, "ok");
   } catch (err) {
-    noticeAbout(name, "Start failed: " + (err.detail || err.message), "error", true);
+    noticeAbout(name, `${what} failed: ` + (err.detail || err.message), "error", true);
   }
-});
+}
+
+$("start-btn").addEventListener("click", () => ask("Start", api.start));
+$("hold-btn").addEventListener("click", () => ask("Stop after this run", api.hold, ": then the loop waits for Start"));
 
 function updateControls() {
   const entry = currentEntry();
@@ -479,6 +504,12 @@ function updateControls() {
   const controllable = !controlRefusal(entry);
   $("preempt-btn").disabled = !live || !running || !controllable;
   $("start-btn").disabled = !live || running || !controllable || !entry.can_start;
+  const hold = $("hold-btn");
+  hold.hidden = !entry?.can_hold;
+  hold.disabled = !live || !running || !controllable || entry.held;
+  const loop = $("loop-state");
+  loop.hidden = !entry?.held;
+  if (loop.textContent !== heldText(running)) loop.textContent = heldText(running);
   const pill = $("run-state");
   const s = app.status;
   const state = s?.structure ? runState(s) : "idle";

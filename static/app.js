@@ -136,11 +136,12 @@ async function pollMachines() {
   }
 }
 
-/** running, done (reached an outcome), failed (ended without one after an error) or idle. */
-function runState(s) {
-  if (s.running) return "running";
-  if (s.outcome !== null && s.outcome !== undefined) return "done";
-  return s.error ? "failed" : "idle";
+/** running, done (reached an outcome), failed (ended without one after an error) or idle; or
+ * disconnected: another process's machine whose publisher left before it ended (`entry`: its
+ * /api/machines entry), so nobody can tell what it does now. */
+function runState(s, entry) {
+  const state = s.running ? "running" : s.outcome !== null && s.outcome !== undefined ? "done" : s.error ? "failed" : "idle";
+  return entry?.connected === false && (state === "running" || state === "idle") ? "disconnected" : state;
 }
 
 /** Whether the other machines that ended without an outcome failed: /api/machines does not say,
@@ -164,7 +165,7 @@ function fillPicker() {
     const live = m.name === app.name && app.status?.structure
       ? app.status // the stream is fresher
       : { running: m.running, outcome: m.outcome, error: app.endings.get(m.name)?.error };
-    const state = runState(live);
+    const state = runState(live, m);
     const text = state === "done" ? "→ " + live.outcome : state;
     return [m.name, `${m.name}  (${text}${m.source === SOURCES.ingest ? ", remote" : ""})`];
   });
@@ -512,7 +513,7 @@ function updateControls() {
   if (loop.textContent !== heldText(running)) loop.textContent = heldText(running);
   const pill = $("run-state");
   const s = app.status;
-  const state = s?.structure ? runState(s) : "idle";
+  const state = s?.structure ? runState(s, entry) : "idle";
   let text = s?.structure ? state : "—";
   if (state === "failed") text = "failed: " + (s.error.exc_type || "error");
   if (state === "done") text = "finished: " + s.outcome;

@@ -1,11 +1,11 @@
 // A preempt that some state does not service: once it is PREEMPT_GRACE_S old, the page names the
 // active states that have not serviced it and says for how long it has waited.
 
-export const PREEMPT_GRACE_S = 3;
+const PREEMPT_GRACE_S = 3;
 
 /** The active states (not containers) that have not serviced the pending preempt: fsm/status.py's
  * Status.preempt_waiting_on, asked of the page's Status. */
-export function preemptWaitingOn(status) {
+function preemptWaitingOn(status) {
   if (!status.preempt) return [];
   const serviced = new Set(status.preempt.serviced);
   return status.activePaths().filter((path) => !Object.hasOwn(status.containers, path) && !serviced.has(path));

@@ -9,7 +9,7 @@ import { confirmPreempt, editInitialState, showMenu } from "./dialogs.js";
 import { SceneView } from "./scene.js";
 import { overduePreemptText } from "./preempt.js";
 import { heldText, holdChange } from "./loop.js";
-import { CONTROLLABLE_SOURCES, SOURCES, edgeId, outcomeId } from "./schema.js";
+import { CONTROLLABLE_SOURCES, SCHEMA_VERSION, SOURCES, edgeId, outcomeId } from "./schema.js";
 
 const $ = (id) => document.getElementById(id);
 const MACHINE_POLL_MS = 2000;
@@ -235,7 +235,7 @@ function onSnapshot(status, lastSeq, history) {
 function onEvents(events) {
   const status = app.status;
   for (const ev of events) {
-    if (ev.v !== undefined && ev.v !== 1) continue; // a schema this page does not know
+    if (ev.v !== undefined && ev.v !== SCHEMA_VERSION) continue; // a schema this page does not know
     status.apply(ev);
     track(ev);
     if (ev.kind === "structure") structureChanged();

@@ -3,19 +3,11 @@
 
 const PREEMPT_GRACE_S = 3;
 
-/** The active states (not containers) that have not serviced the pending preempt: fsm/status.py's
- * Status.preempt_waiting_on, asked of the page's Status. */
-function preemptWaitingOn(status) {
-  if (!status.preempt) return [];
-  const serviced = new Set(status.preempt.serviced);
-  return status.activePaths().filter((path) => !Object.hasOwn(status.containers, path) && !serviced.has(path));
-}
-
 /** What to say at `now` (wall-clock seconds) about a preempt not serviced in time; null: nothing. */
 export function overduePreemptText(status, now) {
   const age = status.preempt ? Math.floor(now - status.preempt.t) : 0;
   if (age < PREEMPT_GRACE_S) return null;
-  const waiting = preemptWaitingOn(status);
+  const waiting = status.preemptWaitingOn();
   if (!waiting.length) return null;
   return `Preempt requested ${age} s ago: ${waiting.join(", ")} ${waiting.length === 1 ? "has" : "have"} not serviced it`;
 }

@@ -115,6 +115,18 @@ export class Status {
     }
   }
 
+  /** The active states that have not serviced the pending preempt (none when there is none). */
+  preemptWaitingOn() {
+    if (this.preempt === null) return [];
+    const serviced = new Set(this.preempt.serviced);
+    return this.activeLeaves().filter((path) => !serviced.has(path));
+  }
+
+  /** The full paths of the active states that are not containers themselves. */
+  activeLeaves() {
+    return this.activePaths().filter((path) => !Object.hasOwn(this.containers, path));
+  }
+
   _setStructure(path, root) {
     this.root_path = path;
     this.structure = root;

@@ -67,3 +67,27 @@ def test_the_seconds_since_the_preempt_was_requested_keep_counting(preempted):
     before = overdue_seconds(preempted)
     preempted.wait_for_function("text => document.getElementById('notice').textContent.includes(text)",
                                 arg="requested %d s ago" % (before + 1))
+
+
+def test_the_page_and_python_agree_on_which_states_a_preempt_waits_on(preempted):
+    """static/status.js preemptWaitingOn() mirrors fsm/status.py preempt_waiting_on()."""
+    import json
+
+    from fsm.status import rebuild
+    from event_support import container, ev, leaf
+
+    sub = container("SUB", "/SM_ROOT/SUB", [leaf("A", "/SM_ROOT/SUB")])
+    root = container("SM_ROOT", "/SM_ROOT", [sub, leaf("B", "/SM_ROOT")])
+    events = [ev(1, "structure", root=root),
+              ev(2, "start", initial=["SUB"], active=["SUB"], userdata={}),
+              ev(3, "start", path="/SM_ROOT/SUB", initial=["A"], active=["A"], userdata={}),
+              ev(4, "preempt", phase="requested"),
+              ev(5, "preempt", path="/SM_ROOT/SUB", phase="requested")]
+    got = preempted.evaluate("""async (events) => {
+        const { Status } = await import('/status.js');
+        const s = new Status('m');
+        for (const e of events) s.apply(e);
+        return s.preemptWaitingOn();
+    }""", json.loads(json.dumps(events)))
+    want = rebuild(events)["m"].preempt_waiting_on()
+    assert got == want == ["/SM_ROOT/SUB/A"]

@@ -28,15 +28,19 @@ class Logs:
         fsm.set_loggers(self._printer("info"), self._printer("warn"), self._printer("debug"), self._printer("error"))
 
 
+# The runtime's own defaults, taken before any test or fixture changed them: a module-scoped
+# fixture that silences the loggers must not leave them silenced for the modules after it.
+_DEFAULT_PRINTERS = dict(fsm.log._printers)
+_DEFAULT_SHUTDOWN_CHECK = fsm.log._shutdown_check
+
+
 @pytest.fixture(autouse=True)
 def _restore_runtime_globals():
     """Put back the default printers and shutdown check, and fail a test that leaves a container open."""
-    printers = dict(fsm.log._printers)
-    shutdown_check = fsm.log._shutdown_check
     yield
     fsm.log._printers.clear()
-    fsm.log._printers.update(printers)
-    fsm.log._shutdown_check = shutdown_check
+    fsm.log._printers.update(_DEFAULT_PRINTERS)
+    fsm.log._shutdown_check = _DEFAULT_SHUTDOWN_CHECK
     left_open = list(Container._construction_stack)
     Container._construction_stack.clear()
     assert not left_open, "a test left containers open: %r" % left_open

@@ -53,6 +53,20 @@ class Waiting(fsm.State):
         return "done"
 
 
+class Stubborn(fsm.State):
+    """Never services a preempt: runs until ``release`` is set (a preempt stays pending meanwhile)."""
+
+    def __init__(self):
+        fsm.State.__init__(self, outcomes=["done"])
+        self.entered = threading.Event()
+        self.release = threading.Event()
+
+    def execute(self, ud):
+        self.entered.set()
+        self.release.wait(60)
+        return "done"
+
+
 def waiting_machine():
     sm = fsm.StateMachine(outcomes=["done", "preempted"])
     wait = Waiting()

@@ -6,18 +6,7 @@ import threading
 
 import fsm
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
-
-
-class Stubborn(fsm.State):
-    """Ignores preemption and runs until released, so a preempt stays 'waiting for the outcome'."""
-
-    def __init__(self):
-        fsm.State.__init__(self, outcomes=["done"])
-        self.release = threading.Event()
-
-    def execute(self, ud):
-        self.release.wait(30)
-        return "done"
+from server_support import Stubborn
 
 
 def one_state_machine(label, state):

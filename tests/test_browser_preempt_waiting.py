@@ -9,21 +9,10 @@ import threading
 import fsm
 import pytest
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from server_support import Stubborn
 from server.introspection_server import ServerThread
 
 OVERDUE = re.compile(r"^Preempt requested (\d+) s ago: /SM_ROOT/STUBBORN has not serviced it$")
-
-
-class Stubborn(fsm.State):
-    """Ignores preemption and runs until released."""
-
-    def __init__(self):
-        fsm.State.__init__(self, outcomes=["done"])
-        self.release = threading.Event()
-
-    def execute(self, ud):
-        self.release.wait(60)
-        return "done"
 
 
 @pytest.fixture(scope="module")

@@ -8,21 +8,7 @@ import time
 
 import fsm
 
-from server_support import client, frames, stream, wait_for, waiting_machine
-
-
-class Stubborn(fsm.State):
-    """Never services a preempt: runs until released."""
-
-    def __init__(self) -> None:
-        fsm.State.__init__(self, outcomes=["done"])
-        self.entered = threading.Event()
-        self.release = threading.Event()
-
-    def execute(self, ud):
-        self.entered.set()
-        self.release.wait(30)
-        return "done"
+from server_support import Stubborn, client, frames, stream, wait_for, waiting_machine
 
 
 def test_a_client_joining_mid_run_gets_the_runs_events_so_far_with_its_snapshot(live_server):

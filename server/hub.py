@@ -270,7 +270,6 @@ class Hub:
         self._scheduled = False
         self._watchdog: asyncio.Task | None = None
         self._hook: Callable | None = None
-        self.rejected = 0  # refused events that named no known machine
         self.scene_url: str | None = None  # a 3D view served beside the dashboard (the sim demo's viser)
 
     # Lifecycle (the app's lifespan calls these on the loop).
@@ -394,10 +393,8 @@ class Hub:
         if problem:
             name = event.get("machine") if type(event) is dict else None
             entry = self._machines.get(name) if type(name) is str else None
-            if entry is not None:
+            if entry is not None:  # one naming no known machine is only answered, not counted
                 entry.rejected += 1
-            else:
-                self.rejected += 1
             return problem
         name = event["machine"]
         with self._lock:

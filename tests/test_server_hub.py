@@ -2,6 +2,7 @@
 
 import asyncio
 import threading
+import time
 
 import fsm
 from fsm.status import Status
@@ -55,8 +56,16 @@ def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
     try:
         wait_for(lambda: len(entry.clients) == 1)
         [client] = list(entry.clients)
-        while client.send_started is None:  # fill the socket buffers until its send blocks
-            sm.execute()
+        # Fill the socket buffers until a send blocks: one that started and is still not done 0.2 s
+        # later (a send that merely happened to be under way would finish and wake the client again).
+        while True:
+            started = client.send_started
+            if started is None:
+                sm.execute()
+            elif time.monotonic() - started < 0.2:
+                time.sleep(0.05)
+            else:
+                break
         counting = client.wake = CountingEvent()
         for _ in range(5):
             sm.execute()  # 5 x 3,000 more events

@@ -12,6 +12,9 @@ from typing import Any, Callable
 from fsm import introspection
 
 
+LAST_RUN_GRACE = 1.0  # seconds a start waits for this handle's previous run to return
+
+
 class ControlError(Exception):
     """A request the machine cannot honour now; ``status`` is the HTTP status to answer."""
 
@@ -175,6 +178,10 @@ class MachineHandle:
             if not self.can_start:
                 self.emit_control("start", client, "this process cannot re-run the machine")
                 raise ControlError(409, "this process cannot re-run the machine (can_start is false)")
+            if self.is_running():
+                # The last run's outcome is out (a page can ask for the next run at once) a moment
+                # before its execute() has returned: give a run of ours that long to wind down.
+                self.join(LAST_RUN_GRACE)
             if self.is_running():
                 self.emit_control("start", client, "already running")
                 raise ControlError(409, "machine is running")

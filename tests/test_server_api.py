@@ -1,6 +1,7 @@
 """REST API against a real uvicorn on a free port, with real fsm machines (docs/api.md)."""
 
 import threading
+import time
 import xml.etree.ElementTree as ET
 
 import fsm
@@ -230,3 +231,15 @@ def test_a_failing_starter_answers_409_with_its_message(live_server):
     live_server.hub.add_local(two_state_machine(), name="hosted", starter=starter)
     answer = client(live_server).post("/api/machines/hosted/start", json={})
     assert answer.status_code == 409 and "no episode" in answer.json()["detail"]
+
+
+def test_start_right_after_the_outcome_is_out_runs_again(live_server):
+    """A page may ask for the next run as soon as it sees the outcome, a moment before the last
+    run's execute() has returned (here a termination callback still runs): that is not a 409."""
+    sm = two_state_machine()
+    sm.register_termination_cb(lambda ud, states, outcome: time.sleep(0.3))
+    live_server.hub.add_local(sm, name="two")
+    http = client(live_server)
+    assert http.post("/api/machines/two/start", json={}).status_code == 202
+    wait_for(lambda: http.get("/api/machines/two/status").json()["outcome"] == "done")
+    assert http.post("/api/machines/two/start", json={}).status_code == 202

@@ -14,7 +14,7 @@ import time
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
 import fsm as smach  # noqa: E402
-from fsm.recorder import Recorder  # noqa: E402
+from fsm.logfiles.recorder import Recorder  # noqa: E402
 
 LOOP_TRANSITIONS = 100_000
 NESTED_STEPS = 100_000

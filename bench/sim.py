@@ -20,7 +20,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 import fsm  # noqa: E402
-from fsm.bus import Bus  # noqa: E402
+from fsm.ros.bus import Bus  # noqa: E402
 from sim.world import HOME_Q, World  # noqa: E402
 
 RUNS = 5

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Callable
 
 if TYPE_CHECKING:
-    from fsm.log_reader import Reader
+    from fsm.logfiles.log_reader import Reader
 
 EXIT_OK, EXIT_ERROR, EXIT_UNREADABLE = 0, 1, 2
 
@@ -122,9 +122,9 @@ def replay(args: argparse.Namespace) -> int:
         return replay_in_browser(args)
     import json
 
-    from fsm.log_reader import LogError, Reader, follow, read_events
-    from fsm.summary import Summary
-    from fsm.transcript import Transcript
+    from fsm.logfiles.log_reader import LogError, Reader, follow, read_events
+    from fsm.logfiles.summary import Summary
+    from fsm.logfiles.transcript import Transcript
 
     reader = Reader(args.log, on_problem=lambda p: print("fsmscope replay: %s: skipped %s" % (args.log, p),
                                                          file=sys.stderr, flush=True))

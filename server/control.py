@@ -217,6 +217,6 @@ class MachineHandle:
 
 def publish(topic: str, message: Any) -> int:
     """Publish on the in-process bus; returns how many subscribers it reached."""
-    from fsm.bus import default_bus
+    from fsm.ros.bus import default_bus
 
     return default_bus.publish(topic, message)

@@ -25,7 +25,7 @@ from typing import Iterable
 
 import pydot
 
-from fsm.schema import container_id, edge_id, outcome_id, state_id
+from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -44,7 +44,7 @@ class GraphError(Exception):
 
 
 # XML cannot hold control characters (Graphviz would write them raw): a label shows each as its
-# Unicode "control picture" (U+2400 + code), ids are percent-escaped by fsm.schema.
+# Unicode "control picture" (U+2400 + code), ids are percent-escaped by fsm.observation.schema.
 _VISIBLE = {c: 0x2400 + c for c in range(0x20)}
 _VISIBLE.update({0x7F: 0x2421, 0xFFFE: 0xFFFD, 0xFFFF: 0xFFFD})
 

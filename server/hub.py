@@ -28,8 +28,8 @@ import time
 from typing import Any, Callable
 
 from fsm import introspection, schema
-from fsm.encoding import dumps
-from fsm.status import Status
+from fsm.observation.encoding import dumps
+from fsm.observation.status import Status
 
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead

@@ -6,7 +6,7 @@ from typing import Any, Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from fsm.schema import SOURCES
+from fsm.observation.schema import SOURCES
 
 JsonValue = Any
 
@@ -82,7 +82,7 @@ class PendingPreempt(BaseModel):
 
 
 class MachineStatus(BaseModel):
-    """``fsm.status.Status.to_dict()`` without ``structure``."""
+    """``fsm.observation.status.Status.to_dict()`` without ``structure``."""
 
     machine: str
     run: Optional[str] = None

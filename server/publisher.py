@@ -4,12 +4,12 @@
     fsm.attach(sm, Publisher("http://127.0.0.1:8765", token), name="picker")
 
 The observer only appends to a bounded buffer (the machine's thread never waits for the
-network). A background thread applies the events to its own ``fsm.status.Status`` and sends
+network). A background thread applies the events to its own ``fsm.observation.status.Status`` and sends
 them in batches over the authenticated websocket ``/api/ingest``. When the server is gone,
 the machine runs on: events keep being folded into the Status, and on reconnecting (with
 backoff) the publisher first sends a ``snapshot`` event of each machine, then new events.
 
-The server checks every event against the schema (``fsm.schema``) and answers a refused one
+The server checks every event against the schema (``fsm.observation.schema``) and answers a refused one
 with a ``rejected`` frame; the publisher counts those (``rejected``) and says why on stderr.
 At exit the publisher sends what it still holds (``close()`` runs from ``atexit``), so a
 script that ends right after its machine does not leave the dashboard showing it running;
@@ -30,8 +30,8 @@ import weakref
 from typing import Any
 
 from fsm import schema
-from fsm.encoding import dumps, loads
-from fsm.status import Status
+from fsm.observation.encoding import dumps, loads
+from fsm.observation.status import Status
 
 BUFFER = 100_000      # events held for the sender before the oldest are dropped
 MAX_BATCH = 2000      # events per frame

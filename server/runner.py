@@ -24,8 +24,8 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import fsm
-from fsm.introspection import reporter_of
-from fsm.recorder import Recorder
+from fsm.observation.introspection import reporter_of
+from fsm.logfiles.recorder import Recorder
 
 MachineCallback = Callable[[str, Any], None]
 

@@ -91,7 +91,7 @@ def replay_in_browser(args: argparse.Namespace) -> int:
     ``--speed``) through the hub's ingest path, so the page cannot tell it from a live machine.
     The first event is shown at once; the clock starts when a browser watches (``--speed 0``:
     no waiting at all)."""
-    from fsm.log_reader import LogError, Reader, read_events
+    from fsm.logfiles.log_reader import LogError, Reader, read_events
 
     reader = Reader(args.log, on_problem=lambda p: print("fsmscope replay: %s: skipped %s" % (args.log, p),
                                                          file=sys.stderr, flush=True))

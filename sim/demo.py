@@ -109,7 +109,7 @@ class SimDemo:
 
     def __init__(self, seed: int = 0, fast: bool = False, bus=None, scene: bool = True,
                  host: str = "127.0.0.1", port: int = 0, speed: float = 1.0):
-        from fsm.bus import get_bus
+        from fsm.ros.bus import get_bus
 
         from .servers import start_servers
         from .world import World
@@ -214,7 +214,7 @@ def run_demo(args: argparse.Namespace) -> int:
     """Physics, action servers, the task machine, its recording, and unless headless the dashboard
     with the 3D view; until the episodes are done, Ctrl-C or SIGTERM. Everything is undone on exit."""
     import fsm
-    from fsm.recorder import Recorder
+    from fsm.logfiles.recorder import Recorder
 
     if not args.verbose:
         _quiet_loggers()

@@ -1,7 +1,7 @@
 """MoveTo and Gripper action servers on the fsm bus.
 
 Each server's work is a plain method ``run(goal, handle)``; ``handle`` is the
-``fsm.actionlib.SimpleActionServer`` (or anything with ``is_preempt_requested``,
+``fsm.ros.actionlib.SimpleActionServer`` (or anything with ``is_preempt_requested``,
 ``publish_feedback``, ``set_succeeded``, ``set_preempted``, ``set_aborted``). Goals,
 feedback and results are plain dicts.
 
@@ -84,7 +84,7 @@ class MoveToServer:
         }
         self.server = None
         if start:
-            from fsm.actionlib import SimpleActionServer
+            from fsm.ros.actionlib import SimpleActionServer
 
             self.server = SimpleActionServer(name, self._execute, auto_start=True, bus=bus)
 
@@ -199,7 +199,7 @@ class GripperServer:
         self.name = name
         self.server = None
         if start:
-            from fsm.actionlib import SimpleActionServer
+            from fsm.ros.actionlib import SimpleActionServer
 
             self.server = SimpleActionServer(name, self._execute, auto_start=True, bus=bus)
 

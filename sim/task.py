@@ -24,7 +24,7 @@ import math
 from typing import Any, Callable
 
 import fsm as smach
-from fsm.actionlib import GoalStatus
+from fsm.ros.actionlib import GoalStatus
 
 from .servers import GRIPPER, MOVE_TO
 from .world import World
@@ -53,8 +53,8 @@ def build_task_machine(world: World, bus=None, max_retries: int = 3) -> smach.Co
     ``execute()`` returns 'succeeded', 'aborted' or 'preempted'. The action servers
     (``sim.servers.start_servers(world, bus)``) must be running on the same bus.
     """
-    from fsm.monitor_state import MonitorState
-    from fsm.simple_action_state import SimpleActionState
+    from fsm.ros.monitor_state import MonitorState
+    from fsm.ros.simple_action_state import SimpleActionState
 
     target = world.target_pos
 

@@ -1,4 +1,4 @@
-// The state of one machine rebuilt from its events: a line-for-line mirror of fsm/status.py,
+// The state of one machine rebuilt from its events: a line-for-line mirror of fsm/observation/status.py,
 // so that the browser, the recorder and replay cannot disagree.
 
 const REDUCED = new Set(["start", "transition", "userdata", "terminate", "error"]);

@@ -3,8 +3,8 @@
 import time
 
 import pytest
-from fsm.actionlib import SimpleActionServer
-from fsm.bus import Bus
+from fsm.ros.actionlib import SimpleActionServer
+from fsm.ros.bus import Bus
 
 
 @pytest.fixture

@@ -1,9 +1,9 @@
 """Shared fixtures: captured log lines, and the runtime's globals restored after every test."""
 
 import fsm
-import fsm.log
+import fsm.core.log
 import pytest
-from fsm.container import Container
+from fsm.core.container import Container
 
 
 class Logs:
@@ -30,17 +30,17 @@ class Logs:
 
 # The runtime's own defaults, taken before any test or fixture changed them: a module-scoped
 # fixture that silences the loggers must not leave them silenced for the modules after it.
-_DEFAULT_PRINTERS = dict(fsm.log._printers)
-_DEFAULT_SHUTDOWN_CHECK = fsm.log._shutdown_check
+_DEFAULT_PRINTERS = dict(fsm.core.log._printers)
+_DEFAULT_SHUTDOWN_CHECK = fsm.core.log._shutdown_check
 
 
 @pytest.fixture(autouse=True)
 def _restore_runtime_globals():
     """Put back the default printers and shutdown check, and fail a test that leaves a container open."""
     yield
-    fsm.log._printers.clear()
-    fsm.log._printers.update(_DEFAULT_PRINTERS)
-    fsm.log._shutdown_check = _DEFAULT_SHUTDOWN_CHECK
+    fsm.core.log._printers.clear()
+    fsm.core.log._printers.update(_DEFAULT_PRINTERS)
+    fsm.core.log._shutdown_check = _DEFAULT_SHUTDOWN_CHECK
     left_open = list(Container._construction_stack)
     Container._construction_stack.clear()
     assert not left_open, "a test left containers open: %r" % left_open

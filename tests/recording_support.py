@@ -6,7 +6,7 @@ import subprocess
 import sys
 
 import fsm
-from fsm.recorder import Recorder
+from fsm.logfiles.recorder import Recorder
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 EXAMPLES = os.path.join(ROOT, "examples")

@@ -1,10 +1,10 @@
-"""fsm.actionlib: a SimpleActionServer and SimpleActionClient talking over a bus, with real threads."""
+"""fsm.ros.actionlib: a SimpleActionServer and SimpleActionClient talking over a bus, with real threads."""
 
 import threading
 
 import pytest
 
-from fsm.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
+from fsm.ros.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
 from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
 
 

@@ -302,9 +302,9 @@ def test_page_recovers_when_the_server_restarts(page, server):
 
 
 def test_js_reducer_matches_python(page):
-    """fsm.status.Status and static/status.js rebuild the same state from the same events, over two runs."""
+    """fsm.observation.status.Status and static/status.js rebuild the same state from the same events, over two runs."""
     import fsm
-    from fsm.status import rebuild
+    from fsm.observation.status import rebuild
 
     import threading
 

@@ -1,5 +1,5 @@
 """State names the graph's ids must escape (a control character, a percent sign): the page finds
-their elements through the same id definition as the server (static/schema.js from fsm/schema.py)."""
+their elements through the same id definition as the server (static/schema.js from fsm/observation/schema.py)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import threading
 import fsm
 import pytest
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
-from fsm.schema import edge_id, state_id
+from fsm.observation.schema import edge_id, state_id
 from server.introspection_server import ServerThread
 
 PERCENT = "100%"

@@ -1,4 +1,4 @@
-"""fsm.bus: topics, services and waits, with real threads."""
+"""fsm.ros.bus: topics, services and waits, with real threads."""
 
 import threading
 import time
@@ -6,7 +6,7 @@ import time
 import pytest
 
 from bus_support import bus  # noqa: F401 (fixture)
-from fsm.bus import ServiceException, default_bus, get_bus
+from fsm.ros.bus import ServiceException, default_bus, get_bus
 
 
 def test_publish_reaches_every_subscriber_of_the_topic_only(bus):

@@ -12,7 +12,7 @@ import time
 
 import httpx
 import pytest
-from fsm.encoding import dumps
+from fsm.observation.encoding import dumps
 
 from recording_support import EXAMPLES, FAST, ROOT, cli
 

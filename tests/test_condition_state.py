@@ -7,7 +7,7 @@ import fsm as smach
 import pytest
 
 from bus_support import eventually
-from fsm.condition_state import ConditionState
+from fsm.ros.condition_state import ConditionState
 from smach_support import Background, machine
 
 

@@ -5,7 +5,7 @@ import threading
 
 import fsm as smach
 import pytest
-from fsm.container import Container
+from fsm.core.container import Container
 
 from smach_support import Out, machine
 

@@ -7,7 +7,7 @@ import math
 
 import fsm
 import numpy as np
-from fsm.encoding import DEFAULT_CAP, encode, encode_userdata
+from fsm.observation.encoding import DEFAULT_CAP, encode, encode_userdata
 from hypothesis import given
 from hypothesis import strategies as st
 

@@ -6,9 +6,9 @@ import threading
 
 import fsm
 import pytest
-from fsm.bus import get_bus
-from fsm.log_reader import read_events
-from fsm.summary import summarize
+from fsm.ros.bus import get_bus
+from fsm.logfiles.log_reader import read_events
+from fsm.logfiles.summary import summarize
 
 from recording_support import EXAMPLES, FAST, cli, load_example, record
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import xml.etree.ElementTree as ET
 
 import fsm
-from fsm.schema import state_id
+from fsm.observation.schema import state_id
 
 from server_support import client
 

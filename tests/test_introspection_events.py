@@ -1,7 +1,7 @@
 """docs/events.md: the events a run emits through ``smach.attach`` and ``fsm.add_global_hook``."""
 
 import fsm as smach
-import fsm.log
+import fsm.core.log
 import pytest
 from fsm import introspection
 
@@ -29,7 +29,7 @@ def observe():
 def nobody_listening(monkeypatch):
     """Hide reporters that other tests left attached, so the global log listener reflects this test alone."""
     monkeypatch.setattr(introspection, "_listening", set())
-    monkeypatch.setattr(fsm.log, "listener", None)
+    monkeypatch.setattr(fsm.core.log, "listener", None)
 
 
 def _fields(events, expected):
@@ -275,21 +275,21 @@ def test_runtime_start_transition_and_termination_lines_are_not_log_events(obser
 
 def test_without_an_observer_there_are_no_events_and_no_log_listener(nobody_listening):
     seen_listener = []
-    sm = machine(["done"], [("A", Out(lambda ud: seen_listener.append(fsm.log.listener) or "done"), {})])
+    sm = machine(["done"], [("A", Out(lambda ud: seen_listener.append(fsm.core.log.listener) or "done"), {})])
     rep = smach.attach(sm)
     sm.execute()
     assert rep.last_seq == 0
     assert seen_listener == [None]
-    assert fsm.log.listener is None
+    assert fsm.core.log.listener is None
 
 
 def test_removing_the_last_observer_clears_the_log_listener(nobody_listening):
     sm = _nested()
     events = []
     rep = smach.attach(sm, events.append)
-    assert fsm.log.listener is not None
+    assert fsm.core.log.listener is not None
     rep.remove_observer(events.append)
-    assert fsm.log.listener is None
+    assert fsm.core.log.listener is None
     sm.execute()
     assert events == []
 

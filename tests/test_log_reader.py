@@ -1,14 +1,14 @@
-"""fsm.log_reader: bad lines, schema versions, following a growing log, seeking."""
+"""fsm.logfiles.log_reader: bad lines, schema versions, following a growing log, seeking."""
 
 import threading
 import time
 
 import fsm
 import pytest
-from fsm.encoding import dumps
-from fsm.log_reader import LogError, SchemaError, follow, read_events, seek
-from fsm.recorder import Recorder, index_path
-from fsm.status import rebuild
+from fsm.observation.encoding import dumps
+from fsm.logfiles.log_reader import LogError, SchemaError, follow, read_events, seek
+from fsm.logfiles.recorder import Recorder, index_path
+from fsm.observation.status import rebuild
 
 from recording_support import two_state_loop, record
 

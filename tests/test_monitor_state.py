@@ -5,7 +5,7 @@ import time
 import fsm as smach
 
 from bus_support import bus, eventually  # noqa: F401 (fixture)
-from fsm.monitor_state import MonitorState
+from fsm.ros.monitor_state import MonitorState
 from smach_support import Background, machine
 
 

@@ -1,4 +1,4 @@
-"""fsm.recorder: the JSON Lines log, its flushing, snapshots and index."""
+"""fsm.logfiles.recorder: the JSON Lines log, its flushing, snapshots and index."""
 
 import os
 import signal
@@ -10,10 +10,10 @@ import time
 
 import fsm
 import pytest
-from fsm.encoding import loads
-from fsm.log_reader import read_events, read_index, writer_active
-from fsm.recorder import Recorder
-from fsm.status import Status, rebuild
+from fsm.observation.encoding import loads
+from fsm.logfiles.log_reader import read_events, read_index, writer_active
+from fsm.logfiles.recorder import Recorder
+from fsm.observation.status import Status, rebuild
 
 from recording_support import two_state_loop, ROOT, load_example, record
 
@@ -124,7 +124,7 @@ KILLED_SCRIPT = textwrap.dedent("""
     import sys, time
     sys.path.insert(0, {root!r})
     import fsm
-    from fsm.recorder import Recorder
+    from fsm.logfiles.recorder import Recorder
     fsm.set_loggers(*[lambda m: None] * 4)
 
     class Tick(fsm.State):

@@ -1,4 +1,4 @@
-"""fsm.schema: every event the runtime emits fits it; what does not fit is refused in words."""
+"""fsm.observation.schema: every event the runtime emits fits it; what does not fit is refused in words."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import os
 import fsm
 import pytest
 from fsm import schema
-from fsm.log_reader import read_events
+from fsm.logfiles.log_reader import read_events
 
 from event_support import deep_root, ev, flat_root, run_of
 from server_support import nested_machine, two_state_machine

@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import fsm
 import httpx
-from fsm.bus import default_bus
+from fsm.ros.bus import default_bus
 
 from server_support import client, nested_machine, two_state_machine, wait_for, waiting_machine
 

@@ -5,7 +5,7 @@ import threading
 import time
 
 import fsm
-from fsm.status import Status
+from fsm.observation.status import Status
 
 from recording_support import two_state_loop
 from server import hub as hub_module

@@ -8,8 +8,8 @@ import fsm as smach
 import pytest
 
 from bus_support import bus, eventually  # noqa: F401 (fixture)
-from fsm.bus import default_bus
-from fsm.service_state import ServiceState
+from fsm.ros.bus import default_bus
+from fsm.ros.service_state import ServiceState
 from smach_support import Background, machine, userdata
 
 

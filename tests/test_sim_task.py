@@ -18,8 +18,8 @@ import pytest
 pytest.importorskip("mujoco")
 
 import fsm  # noqa: E402
-from fsm.actionlib import GoalStatus, SimpleActionClient  # noqa: E402
-from fsm.bus import Bus  # noqa: E402
+from fsm.ros.actionlib import GoalStatus, SimpleActionClient  # noqa: E402
+from fsm.ros.bus import Bus  # noqa: E402
 
 from sim.demo import SimDemo  # noqa: E402
 from sim.ik import IKSolver, tool_down_rotation  # noqa: E402

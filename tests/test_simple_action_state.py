@@ -8,8 +8,8 @@ import fsm as smach
 import pytest
 
 from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
-from fsm.actionlib import GoalStatus
-from fsm.simple_action_state import SimpleActionState
+from fsm.ros.actionlib import GoalStatus
+from fsm.ros.simple_action_state import SimpleActionState
 from smach_support import Background, machine, userdata
 
 

@@ -1,8 +1,8 @@
-"""fsm.status: a start of the root container begins a new run, and the state shows that run only."""
+"""fsm.observation.status: a start of the root container begins a new run, and the state shows that run only."""
 
 import fsm
 import pytest
-from fsm.status import Status
+from fsm.observation.status import Status
 
 SUB = "/SM_ROOT/SUB"
 

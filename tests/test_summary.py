@@ -1,8 +1,8 @@
-"""fsm.summary: outcome, visits and time per state, transitions taken, errors, exit codes."""
+"""fsm.logfiles.summary: outcome, visits and time per state, transitions taken, errors, exit codes."""
 
 import pytest
-from fsm.log_reader import read_events
-from fsm.summary import ERROR, FINISHED, INCOMPLETE, summarize
+from fsm.logfiles.log_reader import read_events
+from fsm.logfiles.summary import ERROR, FINISHED, INCOMPLETE, summarize
 
 from recording_support import load_example, record
 from smach_support import Out, machine

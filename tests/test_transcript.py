@@ -1,9 +1,9 @@
-"""fsm.transcript: the replayed lines are the lines SMACH printed live, word for word."""
+"""fsm.logfiles.transcript: the replayed lines are the lines SMACH printed live, word for word."""
 
 import fsm
 import pytest
-from fsm.log_reader import read_events
-from fsm.transcript import Transcript, messages, transcript
+from fsm.logfiles.log_reader import read_events
+from fsm.logfiles.transcript import Transcript, messages, transcript
 
 from recording_support import load_example, record
 from smach_support import Out, machine

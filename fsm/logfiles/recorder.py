@@ -7,12 +7,12 @@ terminates, or when ``flush_bytes`` bytes wait). ``close()`` writes what is left
 and fsyncs. Nothing is ever fsynced per event.
 
 Every ``snapshot_every`` events of a machine the recorder writes a ``snapshot`` event (the
-state rebuilt by ``fsm.status.Status``) and a line ``{"machine", "seq", "offset"}`` in the
+state rebuilt by ``fsm.observation.status.Status``) and a line ``{"machine", "seq", "offset"}`` in the
 ``<path>.idx`` sidecar, so a reader can rebuild the state at any event without reading the
-log from its start (``fsm.log_reader.seek``).
+log from its start (``fsm.logfiles.log_reader.seek``).
 
 While open, the recorder holds a shared ``flock`` on the log: a reader that can take an
-exclusive lock knows that nobody writes the file any more (``fsm.log_reader.follow``).
+exclusive lock knows that nobody writes the file any more (``fsm.logfiles.log_reader.follow``).
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ import time
 import weakref
 from typing import Any
 
-from . import encoding
-from . import schema
-from .status import Status
+from ..observation import encoding
+from ..observation import schema
+from ..observation.status import Status
 
 try:
     import fcntl

@@ -11,7 +11,8 @@ import threading
 import traceback
 from typing import Any, Callable
 
-from . import introspection, log
+from . import log
+from ..observation import introspection
 from .container import Container
 from .exceptions import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
 from .state import State

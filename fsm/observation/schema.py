@@ -255,7 +255,7 @@ STATUS_FIELDS = (
     Field("preempt", _nullable(Type("a pending preempt", lambda v: _fields_problem(v, PREEMPT_FIELDS))),
           required=False, doc="a preempt requested and not over yet (below)"),
 )
-STATUS = Type("a machine status (fsm.status.Status.to_dict())",
+STATUS = Type("a machine status (fsm.observation.status.Status.to_dict())",
               lambda v: _fields_problem(v, STATUS_FIELDS))
 
 

@@ -4,7 +4,8 @@ import threading
 import traceback
 from typing import Any
 
-from . import introspection, log
+from . import log
+from ..observation import introspection
 from .container import Container
 from .exceptions import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
 from .state import State

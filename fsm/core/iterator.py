@@ -3,7 +3,8 @@
 import traceback
 from typing import Any, Callable, Iterable
 
-from . import introspection, log
+from . import log
+from ..observation import introspection
 from .container import Container
 from .exceptions import InvalidUserCodeError
 from .state import State

@@ -4,11 +4,11 @@ import functools
 import time
 from typing import Any, Callable, Iterable
 
-from . import log
+from ..core import log
 from .actionlib import GoalStatus, SimpleActionClient
 from .bus import Bus, get_bus
-from .encoding import encode
-from .exceptions import InvalidStateError
+from ..observation.encoding import encode
+from ..core.exceptions import InvalidStateError
 from .preemptible import PreemptibleState, to_seconds
 from .slots import set_slot, store
 from .user_callback import FAILED, UserCallback

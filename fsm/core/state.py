@@ -8,7 +8,7 @@ from .util import has_smach_interface
 class State:
     """Base class of every state and container.
 
-    ``_reporter`` and ``_path`` are set by ``fsm.introspection`` when a tool observes the
+    ``_reporter`` and ``_path`` are set by ``fsm.observation.introspection`` when a tool observes the
     machine this state belongs to; they stay None otherwise, which costs nothing.
     """
 

@@ -3,7 +3,7 @@
 import threading
 from typing import Any, Callable
 
-from . import log
+from ..core import log
 from .bus import Bus, get_bus
 from .preemptible import PreemptibleState
 

@@ -2,7 +2,7 @@
 
 * ``read_events(path)`` yields events in file order. A line that is not a complete event
   (a crash cut it short, or it is corrupt), or whose event does not fit the schema
-  (``fsm.schema.validate``), is skipped and reported, with its line number, to
+  (``fsm.observation.schema.validate``), is skipped and reported, with its line number, to
   ``on_problem`` (and kept in ``Reader.problems``). An event of a newer schema version stops
   the read with ``SchemaError``: guessing at it would be worse.
 * ``follow(path)`` does the same for a log still being written, until its writer is gone.
@@ -18,10 +18,10 @@ import time
 from dataclasses import dataclass
 from typing import Any, Callable, Iterator
 
-from .encoding import loads
+from ..observation.encoding import loads
 from .recorder import fcntl, index_path
-from .schema import VERSION, validate
-from .status import Status
+from ..observation.schema import VERSION, validate
+from ..observation.status import Status
 
 SUPPORTED_VERSIONS = (VERSION,)
 

@@ -4,7 +4,7 @@ import time
 import traceback
 from typing import Any, Callable
 
-from .exceptions import InvalidUserCodeError
+from ..core.exceptions import InvalidUserCodeError
 from .preemptible import PreemptibleState, to_seconds
 
 

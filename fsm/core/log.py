@@ -2,7 +2,7 @@
 
 Every line goes to the bound printer (``set_loggers``) and, when a tool listens, to the
 introspection layer as a ``log`` event. ``_quiet`` lines (start, transition, termination)
-are only printed: the events already say them and ``fsm.transcript`` rebuilds them.
+are only printed: the events already say them and ``fsm.logfiles.transcript`` rebuilds them.
 """
 
 from typing import Callable
@@ -16,7 +16,7 @@ _printers: dict[str, Printer] = {
     "error": lambda m: print("[ ERROR ] : " + str(m)),
 }
 
-# Set by fsm.introspection while a reporter listens: listener(level, message).
+# Set by fsm.observation.introspection while a reporter listens: listener(level, message).
 listener: Callable[[str, str], None] | None = None
 
 

@@ -5,7 +5,8 @@ import traceback
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator as TypingIterator
 
-from . import introspection, log
+from . import log
+from ..observation import introspection
 from .exceptions import InvalidConstructionError, InvalidStateError, InvalidTransitionError
 from .state import State
 from .user_data import UserData

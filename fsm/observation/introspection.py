@@ -14,7 +14,7 @@ from threading import get_ident
 from time import time as _now
 from typing import Any, Callable
 
-from . import log
+from ..core import log
 from .encoding import encode_userdata
 from .schema import event as _event
 

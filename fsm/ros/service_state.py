@@ -3,7 +3,7 @@
 import functools
 from typing import Any, Callable, Iterable
 
-from . import log
+from ..core import log
 from .bus import Bus, ServiceException, get_bus
 from .preemptible import PreemptibleState
 from .slots import set_slot, store

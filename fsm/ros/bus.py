@@ -9,7 +9,7 @@ import threading
 import traceback
 from typing import Any, Callable
 
-from . import log
+from ..core import log
 
 
 class ServiceException(Exception):
@@ -169,7 +169,7 @@ class Bus:
     def services(self) -> list[str]:
         return self._services.names()
 
-    # Action servers (used by fsm.actionlib)
+    # Action servers (used by fsm.ros.actionlib)
 
     def register_action_server(self, name: str, server: Any) -> None:
         self._action_servers.add(name, server)

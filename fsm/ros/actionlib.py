@@ -1,4 +1,4 @@
-"""A minimal in-process actionlib: SimpleActionServer and SimpleActionClient over fsm.bus.
+"""A minimal in-process actionlib: SimpleActionServer and SimpleActionClient over fsm.ros.bus.
 
 Semantics follow ROS's simple action server and client: the server runs one goal at a
 time in its own worker thread and a new goal preempts the active one; the client tracks
@@ -10,7 +10,7 @@ import threading
 import traceback
 from typing import Any, Callable
 
-from . import log
+from ..core import log
 from .bus import Bus, call_logged, get_bus
 
 

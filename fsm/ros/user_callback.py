@@ -8,11 +8,11 @@ that raises, or returns an outcome the state does not have, makes the state abor
 import traceback
 from typing import Any, Callable, Iterable
 
-from . import log
-from .exceptions import InvalidStateError
-from .state import State
-from .user_data import Remapper
-from .util import has_smach_interface
+from ..core import log
+from ..core.exceptions import InvalidStateError
+from ..core.state import State
+from ..core.user_data import Remapper
+from ..core.util import has_smach_interface
 
 # What ``UserCallback.run`` returns when the state must abort (already logged).
 FAILED = object()

@@ -2,15 +2,15 @@
 
 smach_ros states block on services, action servers, topics and polls. Each of those waits
 sleeps on ``self._wake``, which ``request_preempt`` sets; waits that may last long also
-wake once a second to notice ``fsm.log.is_shutdown()``, as smach_ros's 1 s loops did.
+wake once a second to notice ``fsm.core.log.is_shutdown()``, as smach_ros's 1 s loops did.
 """
 
 import threading
 import time
 from typing import Any, Callable
 
-from . import log
-from .state import State
+from ..core import log
+from ..core.state import State
 
 # How often a long wait looks at the shutdown check (smach_ros's wait step).
 SHUTDOWN_CHECK_PERIOD = 1.0

@@ -49,7 +49,7 @@ def _enc(value: Any, depth: int) -> Any:
     if module == "numpy":
         if hasattr(value, "tolist"):
             return _enc(value.tolist(), depth)
-    inner = getattr(value, "_obj", None)  # fsm.user_data.Const
+    inner = getattr(value, "_obj", None)  # fsm.core.user_data.Const
     if inner is not None and type(value).__name__ == "Const":
         return _enc(inner, depth)
     return {"$repr": _short_repr(value)}

@@ -1,0 +1,2 @@
+"""Watching a machine: the event schema, the reporter that emits events (``attach``, global hooks),
+the reducer that rebuilds a machine's state from events (``Status``), and JSON encoding of values."""

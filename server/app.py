@@ -61,7 +61,8 @@ def _raw_abort(scope: dict) -> Any:
 
 
 def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int | None = None,
-               title: str = "fsmscope") -> FastAPI:
+               title: str = "fsmscope", scene_url: str | None = None) -> FastAPI:
+    """The dashboard's app; ``scene_url``: a 3D view served beside it (the sim demo's viser), or None."""
     settings = Settings(token=token, host=host, port=port)
 
     @contextlib.asynccontextmanager
@@ -138,7 +139,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
 
     @app.get("/api/scene", response_model=models.Scene, dependencies=auth, responses=ERRORS, tags=["meta"])
     async def scene() -> models.Scene:
-        return models.Scene(url=hub.scene_url)
+        return models.Scene(url=scene_url)
 
     @app.get("/api/machines", response_model=list[models.MachineInfo], dependencies=auth, responses=ERRORS,
              tags=["machines"])

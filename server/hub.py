@@ -270,7 +270,6 @@ class Hub:
         self._scheduled = False
         self._watchdog: asyncio.Task | None = None
         self._hook: Callable | None = None
-        self.scene_url: str | None = None  # a 3D view served beside the dashboard (the sim demo's viser)
 
     # Lifecycle (the app's lifespan calls these on the loop).
     def bind_loop(self, loop: asyncio.AbstractEventLoop) -> None:

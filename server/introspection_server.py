@@ -58,7 +58,7 @@ class ServerThread:
     """A hub's app served by uvicorn in a background thread on a socket bound before it starts."""
 
     def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
-                 log_level: str = "warning") -> None:
+                 log_level: str = "warning", scene_url: str | None = None) -> None:
         from .app import create_app
         import uvicorn
 
@@ -68,7 +68,7 @@ class ServerThread:
         self.host = host
         self.sock = bind_socket(host, port)
         self.port = self.sock.getsockname()[1]
-        self.app = create_app(self.hub, self.token, host=host, port=self.port)
+        self.app = create_app(self.hub, self.token, host=host, port=self.port, scene_url=scene_url)
         self.server = uvicorn.Server(uvicorn_config(self.app, log_level))
         self._thread: threading.Thread | None = None
 

@@ -231,8 +231,8 @@ def run_demo(args: argparse.Namespace) -> int:
         if not args.headless:
             from server.introspection_server import ServerThread
 
-            server = ServerThread(host=args.host, port=args.port, token=args.token or None).start()
-            server.hub.scene_url = demo.scene.url if demo.scene is not None else None
+            server = ServerThread(host=args.host, port=args.port, token=args.token or None,
+                                  scene_url=demo.scene.url if demo.scene is not None else None).start()
             server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set)
             print("fsmscope demo: open %s" % server.url, flush=True)
         print("fsmscope demo: recording to %s" % record_path, flush=True)

@@ -1,0 +1,105 @@
+"""The layering, kept by reading every import (ast), including those inside functions.
+
+fsm is the runtime: the standard library only (orjson when installed) and nothing of the web or
+the simulator. Inside fsm the core never imports its extensions (ros, logfiles). sim never imports
+server; server imports sim only in its composition root, the CLI (server/cli/).
+"""
+
+from __future__ import annotations
+
+import ast
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parent.parent
+
+OPTIONAL_FOR_FSM = {"orjson"}
+
+# Which subpackages of fsm a module of each may import (pytransitions' rule: the core never
+# imports an extension).
+FSM_ARROWS = {
+    "core": {"core", "observation"},
+    "observation": {"observation", "core"},
+    "ros": {"ros", "core", "observation"},
+    "logfiles": {"logfiles", "observation", "core"},
+}
+
+COMPOSITION_ROOT = ROOT / "server" / "cli"
+
+
+def imported_modules(path: Path) -> list[tuple[int, str]]:
+    """Every module a file imports, as absolute dotted names, with the line: relative imports
+    are resolved against the file's own package."""
+    package = list(path.relative_to(ROOT).parts[:-1])  # a module's package; an __init__'s is its own folder
+    found = []
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            found += [(node.lineno, alias.name) for alias in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package[:len(package) - node.level + 1]
+                module = ".".join(base + ([node.module] if node.module else []))
+                if node.module is None:
+                    found += [(node.lineno, "%s.%s" % (module, alias.name)) for alias in node.names]
+                    continue
+            else:
+                module = node.module or ""
+            found.append((node.lineno, module))
+    return sorted(found)
+
+
+def python_files(package: str) -> list[Path]:
+    return sorted((ROOT / package).rglob("*.py"))
+
+
+def where(path: Path, line: int, module: str) -> str:
+    return "%s:%d imports %s" % (path.relative_to(ROOT), line, module)
+
+
+def wrong_arrows_of_fsm(path: Path) -> list[str]:
+    """What a module of fsm imports that it must not: outside the standard library, or a
+    subpackage of fsm its own may not use."""
+    own = path.relative_to(ROOT / "fsm").parts
+    group = own[0] if len(own) > 1 else None
+    wrong = []
+    for line, module in imported_modules(path):
+        top = module.split(".")[0]
+        if top == "fsm":
+            parts = module.split(".")
+            target = parts[1] if len(parts) > 1 else None
+            if group is not None and target in FSM_ARROWS and target not in FSM_ARROWS[group]:
+                wrong.append(where(path, line, module))
+        elif top not in sys.stdlib_module_names and top not in OPTIONAL_FOR_FSM and top != "__future__":
+            wrong.append(where(path, line, module))
+    return wrong
+
+
+def imports_of(path: Path, package: str) -> list[str]:
+    return [where(path, line, module) for line, module in imported_modules(path)
+            if module == package or module.startswith(package + ".")]
+
+
+def test_fsm_imports_only_the_standard_library_and_its_own_lower_layers():
+    wrong = [arrow for path in python_files("fsm") for arrow in wrong_arrows_of_fsm(path)]
+    assert wrong == []
+
+
+def test_sim_never_imports_the_server():
+    wrong = [arrow for path in python_files("sim") for arrow in imports_of(path, "server")]
+    assert wrong == []
+
+
+def test_the_server_imports_sim_only_in_the_composition_root():
+    wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
+             for arrow in imports_of(path, "sim")]
+    assert wrong == []
+
+
+def test_the_check_sees_a_wrong_arrow_inside_a_function(tmp_path, monkeypatch):
+    fake_root = tmp_path
+    module = fake_root / "fsm" / "core" / "bad.py"
+    module.parent.mkdir(parents=True)
+    module.write_text("def later():\n    from ..logfiles import recorder\n    import fastapi\n")
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", fake_root)
+    assert wrong_arrows_of_fsm(module) == ["fsm/core/bad.py:2 imports fsm.logfiles",
+                                           "fsm/core/bad.py:3 imports fastapi"]

@@ -26,7 +26,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(
 
 import fsm  # noqa: E402
 from fsm.observation.encoding import dumps  # noqa: E402
-from server.introspection_server import ServerThread  # noqa: E402
+from server.http_server import ServerThread  # noqa: E402
 from server_support import stalled_stream  # noqa: E402  (the stalled browser of the tests)
 
 

@@ -60,7 +60,7 @@ def live_server():
 
     Yields the ServerThread: ``.hub``, ``.base_url`` (http://127.0.0.1:PORT), ``.port``, ``.token``.
     """
-    from server.introspection_server import ServerThread
+    from server.http_server import ServerThread
 
     srv = ServerThread().start()
     try:

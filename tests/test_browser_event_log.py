@@ -5,7 +5,7 @@ from __future__ import annotations
 import fsm
 import pytest
 from browser_support import browser, filter_log, watch  # noqa: F401 (browser is a fixture)
-from server.introspection_server import ServerThread
+from server.http_server import ServerThread
 
 
 def pick_and_lift():

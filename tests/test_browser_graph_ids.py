@@ -9,7 +9,7 @@ import fsm
 import pytest
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
 from fsm.observation.schema import edge_id, state_id
-from server.introspection_server import ServerThread
+from server.http_server import ServerThread
 
 PERCENT = "100%"
 VT = "VT\x0bBAD"

@@ -9,7 +9,7 @@ import fsm
 import pytest
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
 from server.hub import HISTORY
-from server.introspection_server import ServerThread
+from server.http_server import ServerThread
 from server_support import wait_for
 
 

@@ -7,7 +7,7 @@ import threading
 import fsm
 import pytest
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
-from server.introspection_server import ServerThread
+from server.http_server import ServerThread
 
 SUB = "/SM_ROOT/SUB"
 

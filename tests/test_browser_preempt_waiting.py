@@ -10,7 +10,7 @@ import fsm
 import pytest
 from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
 from server_support import Stubborn
-from server.introspection_server import ServerThread
+from server.http_server import ServerThread
 
 OVERDUE = re.compile(r"^Preempt requested (\d+) s ago: /SM_ROOT/STUBBORN has not serviced it$")
 

@@ -95,7 +95,7 @@ def endpoints_answer(base_url: str, token: str) -> None:
 
 @pytest.fixture(scope="module")
 def server():
-    from server.introspection_server import ServerThread
+    from server.http_server import ServerThread
 
     srv = ServerThread().start()
     yield srv

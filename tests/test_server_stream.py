@@ -149,7 +149,7 @@ def test_ingest_without_token_is_refused_401(live_server):
 
 
 def test_publisher_keeps_the_machine_running_without_a_server_and_reconnects():
-    from server.introspection_server import ServerThread
+    from server.http_server import ServerThread
 
     srv = ServerThread().start()
     port, token = srv.port, srv.token

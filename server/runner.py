@@ -152,9 +152,3 @@ def _sigterm_as_exit(noted: Callable[[int], None]) -> Callable[[], None]:
             signal.signal(signal.SIGTERM, signal.SIG_DFL)
     return restore
 
-
-def run_script(script: str, args: list[str] | None = None, record: str | None = None,
-               on_machine: list[MachineCallback] | None = None) -> tuple[int, Runner]:
-    """Run ``script`` with recording; returns (exit code, the Runner with its machines and log path)."""
-    runner = Runner(script, list(args or []), record, list(on_machine or []))
-    return runner.run(), runner

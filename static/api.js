@@ -39,10 +39,8 @@ async function request(method, url, body, accept = "json") {
 const machine = (name) => "/api/machines/" + encodeURIComponent(name);
 
 export const api = {
-  health: () => request("GET", "/api/health"),
   machines: () => request("GET", "/api/machines"),
   scene: () => request("GET", "/api/scene"),
-  structure: (name) => request("GET", machine(name) + "/structure"),
   status: (name) => request("GET", machine(name) + "/status"),
   graphSvg(name, expand) {
     const query = new URLSearchParams();

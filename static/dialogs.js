@@ -17,7 +17,7 @@ export function confirmPreempt(machine) {
 }
 
 /** Parse the editor's text: a JSON object, or an error message. */
-export function parseUserdata(text) {
+function parseUserdata(text) {
   if (!text.trim()) return { value: {} };
   let value;
   try {
@@ -127,7 +127,7 @@ function escape(e) {
   if (e.key === "Escape") hideMenu();
 }
 
-export function hideMenu() {
+function hideMenu() {
   document.getElementById("menu").hidden = true;
   document.removeEventListener("pointerdown", outside, { capture: true });
   document.removeEventListener("keydown", escape, { capture: true });

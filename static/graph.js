@@ -70,7 +70,7 @@ export class GraphView {
   }
 
   /** Load the layout for `key` (a string naming structure + expand set) unless already shown. */
-  async load(key, fetchSvg, { keepView = false } = {}) {
+  async load(key, fetchSvg) {
     if (key === this.key) return false;
     const token = ++this.loadToken;
     const text = await fetchSvg();
@@ -88,14 +88,12 @@ export class GraphView {
     svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
     svg.removeAttribute("style");
     svg.classList.add("graph-svg");
-    const previous = this.vb;
     this.svg = svg;
     this.base = base;
     this.key = key;
     this.classed = new Map();
     this.host.replaceChildren(svg);
-    if (keepView && previous) this._setViewBox(previous);
-    else this.fit();
+    this.fit();
     return true;
   }
 

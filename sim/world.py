@@ -352,11 +352,3 @@ class World:
                     self._cond.wait(0.5)
             finally:
                 self._waiting.remove(target)
-
-    def snapshot(self) -> tuple[np.ndarray, np.ndarray]:
-        """Copies of body positions and orientations (wxyz) for drawing."""
-        with self.lock:
-            return self.data.xpos.copy(), self.data.xquat.copy()
-
-    def close(self) -> None:
-        self.stop()

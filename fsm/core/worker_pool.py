@@ -59,9 +59,5 @@ class WorkerPool:
                     del fn, args
                     self._lock.acquire()
 
-    @property
-    def size(self) -> int:
-        return self._count
-
 
 pool = WorkerPool()

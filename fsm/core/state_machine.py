@@ -25,6 +25,7 @@ class StateMachine(Container):
         self._current_transitions: dict | None = None
         self._preempted_label: Any = None
         self._preempted_state: State | None = None
+        self._failed_label: Any = None  # the state whose failure ended the last run
         self._states: dict[str, State] = {}
         self._transitions: dict[str, dict] = {}
         self._remappings: dict[str, dict] = {}
@@ -175,45 +176,45 @@ class StateMachine(Container):
         raise InvalidTransitionError("Outcome '%s' of state '%s' with transition target '%s' is neither a registered state nor a registered container outcome."
                                      % (str(outcome), str(last_state_label), str(target)))
 
-    def execute(self, parent_ud: Any = None) -> Any:
+    def _on_failure(self) -> Any:
+        return self._failed_label
+
+    def _execute(self, parent_ud: Any) -> Any:
         """Run to a container outcome; None after a failed consistency check or a shutdown."""
-        ctx = self._report_start(parent_ud)
-        try:
-            with self._state_transitioning_lock:
-                try:
-                    self.check_consistency()
-                except (InvalidStateError, InvalidTransitionError):
-                    log.logerr("Container consistency check failed.")
-                    self._report("terminate", {"last": [], "outcome": None, "active": [],
-                                               "error": "consistency check failed"})
-                    return None
-                self._is_running = True
-                self._preempted_label = None
-                self._preempted_state = None
-                self._remappers = {}
-                self._set_current_state(self._initial_state_label)
-                self._copy_input_keys(parent_ud, self.userdata)
-                log.info_quiet("State machine starting in initial state '%s' with userdata: \n\t%s"
-                               % (self._current_label, list(self.userdata.keys())))
-                self._report_started()
-                self.call_start_cbs()
-                container_outcome = None
-                try:
-                    while container_outcome is None and self._is_running and not log.is_shutdown():
-                        container_outcome = self._update_once()
-                except BaseException as exc:
-                    self._report_error(self._current_label, exc)
-                    raise
-                finally:
-                    # Fixed against SMACH: after an error no state is reported active.
-                    self._is_running = False
-                    self._set_current_state(None)
-                if container_outcome is None:
-                    self._report("terminate", {"last": [], "outcome": None, "active": [], "error": "shutdown"})
-                self._copy_output_keys(self.userdata, parent_ud)
-                return container_outcome
-        finally:
-            introspection.leave(ctx)
+        with self._state_transitioning_lock:
+            self._failed_label = None
+            try:
+                self.check_consistency()
+            except (InvalidStateError, InvalidTransitionError):
+                log.logerr("Container consistency check failed.")
+                self._report("terminate", {"last": [], "outcome": None, "active": [],
+                                           "error": "consistency check failed"})
+                return None
+            self._is_running = True
+            self._preempted_label = None
+            self._preempted_state = None
+            self._remappers = {}
+            self._set_current_state(self._initial_state_label)
+            self._copy_input_keys(parent_ud, self.userdata)
+            log.info_quiet("State machine starting in initial state '%s' with userdata: \n\t%s"
+                           % (self._current_label, list(self.userdata.keys())))
+            self._report_started()
+            self.call_start_cbs()
+            container_outcome = None
+            try:
+                while container_outcome is None and self._is_running and not log.is_shutdown():
+                    container_outcome = self._update_once()
+            except BaseException:
+                self._failed_label = self._current_label
+                raise
+            finally:
+                # Fixed against SMACH: after an error no state is reported active.
+                self._is_running = False
+                self._set_current_state(None)
+            if container_outcome is None:
+                self._report("terminate", {"last": [], "outcome": None, "active": [], "error": "shutdown"})
+            self._copy_output_keys(self.userdata, parent_ud)
+            return container_outcome
 
     def _preempt_current_state(self) -> None:
         if self._preempted_state is not self._current_state:

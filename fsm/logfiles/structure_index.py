@@ -6,15 +6,7 @@ is (a StateMachine prints different lines from a Concurrence).
 
 from __future__ import annotations
 
-from typing import Iterator
-
-STATE_MACHINE_TYPES = ("StateMachine", "Sequence")
-
-
-def _walk(node: dict) -> Iterator[dict]:
-    yield node
-    for child in node.get("children", ()):
-        yield from _walk(child)
+from ..observation.structure import container_kind, containers
 
 
 class StructureIndex:
@@ -32,9 +24,8 @@ class StructureIndex:
                 self.add(event["machine"], root)
 
     def add(self, machine: str, root: dict) -> None:
-        for node in _walk(root):
-            if node.get("container"):
-                self._nodes[(machine, node["path"])] = node
+        for node in containers(root):
+            self._nodes[(machine, node["path"])] = node
 
     def node(self, machine: str, path: str) -> dict | None:
         return self._nodes.get((machine, path))
@@ -43,14 +34,7 @@ class StructureIndex:
         """The container class behind ``event["path"]``; guessed from the event without a structure."""
         node = self._nodes.get((event["machine"], event["path"]))
         if node is not None:
-            kind = node.get("type", "StateMachine")
-            if kind in STATE_MACHINE_TYPES or kind in ("Concurrence", "Iterator"):
-                return kind
-            if "outcome_map" in node:  # subclasses keep their parent's fields
-                return "Concurrence"
-            if "exhausted_outcome" in node:
-                return "Iterator"
-            return "StateMachine"
+            return container_kind(node)
         if event.get("kind") == "transition" and event.get("to") is None:
             return "Concurrence"
         if event.get("kind") == "terminate" and "outcomes" in event:

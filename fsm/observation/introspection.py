@@ -17,6 +17,7 @@ from typing import Any, Callable
 from ..core import log
 from .encoding import encode_userdata
 from .schema import event as _event
+from .structure import children, is_container
 
 DEFAULT_ROOT_PATH = "/SM_ROOT"
 
@@ -103,7 +104,7 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
     state._reporter = rep
     state._path = path
     node = {"label": label, "path": path, "type": type(state).__name__,
-            "container": hasattr(state, "get_children"),
+            "container": is_container(state),
             "outcomes": sorted(map(str, state.get_registered_outcomes())),
             "input_keys": sorted(map(str, state.get_registered_input_keys())),
             "output_keys": sorted(map(str, state.get_registered_output_keys())),
@@ -115,7 +116,7 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
     remappings = getattr(state, "_remappings", {})
     node["initial"] = [str(s) for s in state.get_initial_states()]
     node["children"] = [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
-                        for lbl, child in state.get_children().items()]
+                        for lbl, child in children(state).items()]
     node["transitions"] = [{"from": str(frm), "outcome": str(outcome), "to": None if to is None else str(to)}
                            for outcome, frm, to in state.get_internal_edges()]
     node.update(state._introspection_info())

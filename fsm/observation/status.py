@@ -7,18 +7,13 @@ replayed run and a live one cannot disagree.
 from __future__ import annotations
 
 import copy
-from typing import Any, Iterator
+from typing import Any
+
+from .structure import containers
 
 
 def _container_entry(initial: list[str] | None = None) -> dict:
     return {"active": [], "initial": list(initial or []), "userdata": {}, "running": False, "outcome": None}
-
-
-def _containers(node: dict) -> Iterator[dict]:
-    if node.get("container"):
-        yield node
-        for child in node.get("children", ()):
-            yield from _containers(child)
 
 
 class Status:
@@ -107,7 +102,7 @@ class Status:
         self.structure = root
         previous = self.containers
         self.containers = {}
-        for node in _containers(root):
+        for node in containers(root):
             entry = previous.get(node["path"]) or _container_entry()
             entry["initial"] = list(node.get("initial", []))
             self.containers[node["path"]] = entry

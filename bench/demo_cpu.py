@@ -14,10 +14,11 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+# The repository first: run as a script, this folder comes first and its server.py would shadow the package.
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
-from browser_support import DemoProcess, launch_chromium  # noqa: E402
+from server.testing.browser import launch_chromium, open_page  # noqa: E402
+from server.testing.demo_process import DemoProcess  # noqa: E402
 
 TICKS = os.sysconf("SC_CLK_TCK")
 
@@ -49,8 +50,7 @@ def main() -> None:
                 from playwright.sync_api import sync_playwright
                 with sync_playwright() as pw:
                     browser = launch_chromium(pw)
-                    page = browser.new_page(viewport={"width": 1600, "height": 900})
-                    page.goto(demo.url)
+                    page = open_page(browser, demo.url, 1600, 900, timeout_ms=30000)
                     page.wait_for_selector("#scene-pane:not([hidden]) iframe")
                     time.sleep(3)
                     watched.append(share_of_one_core(demo.proc.pid, args.seconds))

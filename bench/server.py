@@ -22,12 +22,11 @@ import threading
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tests"))
 
 import fsm  # noqa: E402
 from fsm.observation.encoding import dumps  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
-from server_support import stalled_stream  # noqa: E402  (the stalled browser of the tests)
+from server.testing.clients import stalled_stream  # noqa: E402  (the stalled browser of the tests)
 
 
 def rss_mb():

@@ -3,7 +3,7 @@
     .venv/bin/python docs/screenshot.py
 
 Runs `fsmscope demo` as a real process and drives Debian's Chromium with Playwright, the
-same tooling as the browser tests (tests/browser_support.py).
+same tooling as the browser tests (server.testing).
 """
 
 import sys
@@ -11,13 +11,12 @@ import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests"))
+from playwright.sync_api import sync_playwright
 
-from browser_support import DemoProcess, launch_chromium  # noqa: E402
-from playwright.sync_api import sync_playwright  # noqa: E402
+from server.testing.browser import launch_chromium, open_page
+from server.testing.demo_process import DemoProcess
 
-OUT = ROOT / "docs" / "demo.png"
+OUT = Path(__file__).resolve().parent / "demo.png"
 # Mid-episode: the arm carries the cube.
 WANTED = "s:/SM_ROOT/TASK/PLACE/TRANSPORT"
 
@@ -28,9 +27,7 @@ def main() -> int:
         try:
             with sync_playwright() as pw:
                 browser = launch_chromium(pw)
-                page = browser.new_page(viewport={"width": 1600, "height": 900})
-                page.goto(demo.url)
-                page.wait_for_selector("#graph svg")
+                page = open_page(browser, demo.url, 1600, 900, timeout_ms=30000)
                 page.wait_for_selector("#scene-pane:not([hidden]) iframe")
                 scene = page.frame_locator("#scene-pane iframe")
                 scene.locator("canvas").first.wait_for(state="visible")

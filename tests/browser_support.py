@@ -1,26 +1,19 @@
-"""Debian's Chromium driven by Playwright, and the demo as a real process: shared by the browser
-tests and docs/screenshot.py (the README's screenshot is made with the same tooling)."""
+"""Helpers of the browser tests: the dashboard's page for a machine of a live server, the
+active state as the graph shows it, the event log's filter, and Debian's Firefox over WebDriver
+BiDi. Chromium and the demo process are in server.testing (bench/ and docs/ use them too)."""
 
 from __future__ import annotations
 
 import os
 import re
-import shutil
 import signal
-import socket
 import subprocess
-import sys
-import time
 import urllib.parse
 from pathlib import Path
 
-import pytest
+from server.testing.browser import open_page
+from server.testing.polling import wait_for
 
-CHROMIUM = "/usr/bin/chromium"
-# No downloads and no GPU here: software WebGL (for viser's scene) and no background networking.
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
-                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
-                 "--enable-unsafe-swiftshader"]
 ROOT = Path(__file__).resolve().parents[1]
 # The id of the deepest state the graph highlights as active (a JavaScript expression), or null.
 ACTIVE_LEAF = """(() => {
@@ -28,39 +21,6 @@ ACTIVE_LEAF = """(() => {
     ids.sort((a, b) => b.length - a.length);
     return ids[0] || null;
 })()"""
-FSMSCOPE = [sys.executable, "-m", "server.cli"]
-
-
-def launch_chromium(playwright):
-    """A headless Chromium from the Debian package, with a fresh temporary profile."""
-    return playwright.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS, headless=True)
-
-
-@pytest.fixture(scope="module")
-def browser():
-    """Debian's Chromium, shared by the tests of one module (import this fixture into the module)."""
-    playwright_api = pytest.importorskip("playwright.sync_api")
-    if not os.path.exists(CHROMIUM):
-        pytest.skip("Debian's chromium is not installed (make apt)")
-    if not shutil.which("dot"):
-        pytest.skip("Graphviz's dot is not installed (make apt)")  # the server draws the graph with it
-    with playwright_api.sync_playwright() as pw:
-        chromium = launch_chromium(pw)
-        yield chromium
-        chromium.close()
-
-
-def open_page(browser, url: str, width: int = 1280, height: int = 800, timeout_ms: int = 15000):
-    """A new page of ``browser`` at ``width`` x ``height``, loaded from ``url``, showing a graph.
-
-    ``page.errors`` collects the page's uncaught errors."""
-    page = browser.new_page(viewport={"width": width, "height": height})
-    page.set_default_timeout(timeout_ms)
-    page.errors = []
-    page.on("pageerror", lambda e: page.errors.append(str(e)))
-    page.goto(url)
-    page.wait_for_selector("#graph svg")
-    return page
 
 
 def watch(browser, server, machine: str):
@@ -69,53 +29,6 @@ def watch(browser, server, machine: str):
     page.wait_for_selector("#badge.live")
     assert page.input_value("#machine-picker") == machine
     return page
-
-
-def free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
-
-
-class DemoProcess:
-    """``fsmscope demo`` in its own process group; ``url`` is the dashboard address it printed."""
-
-    def __init__(self, record: Path, *extra: str, token: str = "demo-test-token") -> None:
-        self.token = token
-        self.record = record
-        self.port = free_port()
-        self.proc = subprocess.Popen(
-            FSMSCOPE + ["demo", "--port", str(self.port), "--token", token, "--record", str(record), *extra],
-            cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
-        self.url = self._wait_for_url()
-
-    def _wait_for_url(self, timeout: float = 60.0) -> str:
-        deadline = time.monotonic() + timeout
-        lines = []
-        while time.monotonic() < deadline:
-            line = self.proc.stdout.readline()
-            if not line:
-                break
-            lines.append(line)
-            found = re.search(r"open (http://\S+)", line)
-            if found:
-                return found.group(1)
-        self.stop()
-        raise RuntimeError("fsmscope demo printed no URL:\n" + "".join(lines))
-
-    def stop(self, timeout: float = 20.0) -> int:
-        """SIGINT, as Ctrl-C would; returns the exit code."""
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGINT)
-            try:
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait()
-        if self.proc.stdout is not None:
-            self.rest = self.proc.stdout.read()
-            self.proc.stdout.close()
-        return self.proc.returncode
 
 
 FIREFOX = "/usr/bin/firefox-esr"
@@ -156,17 +69,20 @@ class Firefox:
         self.context = self.command("browsingContext.getTree", {})["contexts"][0]["context"]
 
     def _wait_for_bidi(self, timeout: float) -> str:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
+        def listening_url() -> str | None:
             self._log.seek(0)
             found = re.search(r"WebDriver BiDi listening on (ws://\S+)", self._log.read())
             if found:
                 return found.group(1)
             if self.proc.poll() is not None:
-                break
-            time.sleep(0.1)
-        self.close()
-        raise RuntimeError("Firefox did not start WebDriver BiDi")
+                raise ChildProcessError("Firefox exited")
+            return None
+
+        try:
+            return wait_for(listening_url, timeout, interval=0.1, what="Firefox to start WebDriver BiDi")
+        except (ChildProcessError, TimeoutError) as gave_up:
+            self.close()
+            raise RuntimeError("Firefox did not start WebDriver BiDi") from gave_up
 
     def command(self, method: str, params: dict) -> dict:
         import json
@@ -192,13 +108,9 @@ class Firefox:
         return result["result"].get("value")
 
     def wait_for(self, expression: str, timeout: float = 15.0):
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            value = self.evaluate(expression)
-            if value:
-                return value
-            time.sleep(0.1)
-        raise TimeoutError("never true in Firefox: " + expression)
+        """The truthy value of a JavaScript expression, once it has one."""
+        return wait_for(lambda: self.evaluate(expression), timeout, interval=0.1,
+                        what="true in Firefox: " + expression)
 
     def screenshot(self, path: Path) -> None:
         import base64

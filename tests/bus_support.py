@@ -38,15 +38,3 @@ def until_preempted(server: SimpleActionServer, result=None):
             time.sleep(0.005)
         server.set_preempted(result if result is not None else {"stopped": goal}, "stopped")
     return execute
-
-
-
-def eventually(predicate, timeout: float = 1.0) -> bool:
-    """Poll ``predicate`` until true or ``timeout`` s pass (tests only: the runtime never polls)."""
-    deadline = time.monotonic() + timeout
-    while not predicate():
-        if time.monotonic() > deadline:
-            return False
-        time.sleep(0.001)
-    return True
-

@@ -1,4 +1,8 @@
-"""Shared fixtures: captured log lines, and the runtime's globals restored after every test."""
+"""Shared fixtures: captured log lines, the runtime's globals restored after every test, a live
+server, and Debian's Chromium for the browser tests."""
+
+import os
+import shutil
 
 import fsm
 import fsm.core.log
@@ -67,3 +71,20 @@ def live_server():
         yield srv
     finally:
         srv.stop()
+
+
+@pytest.fixture(scope="module")
+def browser():
+    """Debian's Chromium, shared by the tests of one module; skips when it, Playwright or Graphviz
+    (the server draws the graph with dot) is missing. Playwright is imported here, not at collection."""
+    from server.testing.browser import CHROMIUM, launch_chromium
+
+    playwright_api = pytest.importorskip("playwright.sync_api")
+    if not os.path.exists(CHROMIUM):
+        pytest.skip("Debian's chromium is not installed (make apt)")
+    if not shutil.which("dot"):
+        pytest.skip("Graphviz's dot is not installed (make apt)")
+    with playwright_api.sync_playwright() as pw:
+        chromium = launch_chromium(pw)
+        yield chromium
+        chromium.close()

@@ -1,12 +1,13 @@
 """Helpers for the server tests: small machines, an authenticated HTTP client, websocket frames."""
 
+import contextlib
 import json
-import socket
 import threading
 import time
 
 import fsm
 import httpx
+from server.testing.polling import wait_for
 from websockets.sync.client import connect
 
 
@@ -107,37 +108,19 @@ def stream(srv, name, since=None, token=True, **kw):
 def frames(ws, until, timeout=5.0):
     """Receive frames until ``until(frames)`` is true; returns the parsed frames."""
     got = []
-    deadline = time.monotonic() + timeout
-    while not until(got):
-        remaining = deadline - time.monotonic()
-        if remaining <= 0:
-            raise AssertionError("timed out; frames so far: %r" % got[-5:])
-        got.append(json.loads(ws.recv(timeout=remaining)))
+
+    def receive_one() -> bool:
+        with contextlib.suppress(TimeoutError):
+            got.append(json.loads(ws.recv(timeout=0.05)))
+        return until(got)
+
+    wait_for(lambda: until(got) or receive_one(), timeout, interval=0,
+             what=lambda: "the frames wanted; frames so far: %r" % got[-5:])
     return got
 
 
 def events_of(frame_list):
     return [e for f in frame_list if f["type"] == "events" for e in f["events"]]
-
-
-def wait_for(predicate, timeout=5.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if predicate():
-            return
-        time.sleep(0.005)
-    raise AssertionError("condition not met in %.1f s" % timeout)
-
-
-def stalled_stream(srv, name):
-    """A websocket to ``name``'s stream that completes the handshake and then never reads (a stalled browser)."""
-    raw = socket.create_connection(("127.0.0.1", srv.port))
-    raw.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
-    raw.sendall(("GET /api/machines/%s/stream?token=%s HTTP/1.1\r\nHost: 127.0.0.1:%d\r\nUpgrade: websocket\r\n"
-                 "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
-                 "Sec-WebSocket-Version: 13\r\n\r\n" % (name, srv.token, srv.port)).encode())
-    assert b"101" in raw.recv(200)
-    return raw
 
 
 def blob_loop(n, size=2000):

@@ -5,7 +5,8 @@ import threading
 import pytest
 
 from fsm.ros.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
-from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from bus_support import bus, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from server.testing.polling import wait_for
 
 
 def running_goal(bus, servers):
@@ -89,7 +90,7 @@ def test_pending_goal_replaced_by_a_newer_one_is_preempted_without_running(bus, 
     server = serve(bus, servers, execute)
     clients = [SimpleActionClient("act", bus=bus) for _ in range(3)]
     clients[0].send_goal("a")
-    assert eventually(server.is_active)
+    wait_for(server.is_active)
     clients[1].send_goal("b")
     clients[2].send_goal("c")
     assert clients[1].wait_for_result(timeout=1.0)

@@ -15,7 +15,9 @@ import urllib.request
 from pathlib import Path
 
 import pytest
-from browser_support import ACTIVE_LEAF, browser, filter_log, free_port  # noqa: F401 (browser is a fixture)
+from browser_support import ACTIVE_LEAF, filter_log
+from server.testing.demo_process import free_port
+from server.testing.polling import wait_for
 
 XSS = "<img src=x onerror=alert(1)>"
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,16 +102,17 @@ class ServerProcess:
         with open(self.log, "ab") as log:
             self.proc = subprocess.Popen([sys.executable, __file__, "--serve", str(self.port), self.token],
                                          cwd=str(ROOT), stdout=log, stderr=log)
-        deadline = time.monotonic() + 15
-        while time.monotonic() < deadline:
-            if self.proc.poll() is not None:
-                raise RuntimeError("server exited: " + self.log.read_text()[-2000:])
-            try:
-                with urllib.request.urlopen(self.base + "/api/health", timeout=0.5):
-                    return
-            except OSError:
-                time.sleep(0.05)
-        raise RuntimeError("server did not answer: " + self.log.read_text()[-2000:])
+        wait_for(self._answers, 15, interval=0.05,
+                 what=lambda: "the server to answer; its log: " + self.log.read_text()[-2000:])
+
+    def _answers(self) -> bool:
+        if self.proc.poll() is not None:
+            raise RuntimeError("server exited: " + self.log.read_text()[-2000:])
+        try:
+            with urllib.request.urlopen(self.base + "/api/health", timeout=0.5):
+                return True
+        except OSError:
+            return False
 
     def kill(self) -> None:
         if self.proc is not None and self.proc.poll() is None:

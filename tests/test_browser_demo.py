@@ -4,10 +4,12 @@ from __future__ import annotations
 
 import io
 import os
-import time
 
 import pytest
-from browser_support import ACTIVE_LEAF, CHROMIUM, DemoProcess, launch_chromium, open_page
+from browser_support import ACTIVE_LEAF
+from server.testing.browser import CHROMIUM, launch_chromium, open_page
+from server.testing.demo_process import DemoProcess
+from server.testing.polling import wait_for
 
 # The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
 # clearly red > green > blue.
@@ -43,14 +45,12 @@ def test_demo_page_draws_the_arm_in_the_3d_view(page):
     scene.locator("canvas").first.wait_for(state="visible")
     from PIL import Image
 
-    deadline = time.monotonic() + 30
-    orange = 0
-    while time.monotonic() < deadline:
+    def many_orange_pixels() -> int:
         shot = Image.open(io.BytesIO(page.locator("#scene-pane .scene").screenshot())).convert("RGB")
         orange = sum(1 for pixel in shot.get_flattened_data() if is_arm_orange(*pixel))
-        if orange > 200:
-            break
-        time.sleep(1.0)
+        return orange if orange > 200 else 0
+
+    orange = wait_for(many_orange_pixels, 30, interval=1.0, what="arm-coloured pixels in the 3D view")
     assert orange > 200, "no arm-coloured pixels in the 3D view"
 
 
@@ -58,10 +58,12 @@ def test_demo_page_draws_the_arm_in_the_3d_view(page):
 def test_demo_graph_highlights_the_running_state_as_the_arm_moves(page):
     page.wait_for_function(ACTIVE_LEAF + " !== null")
     seen = {page.evaluate(ACTIVE_LEAF)}
-    deadline = time.monotonic() + 30
-    while len(seen) < 3 and time.monotonic() < deadline:
-        time.sleep(0.2)
+
+    def three_seen() -> bool:
         seen.add(page.evaluate(ACTIVE_LEAF))
+        return len(seen) >= 3
+
+    wait_for(three_seen, 30, interval=0.2, what=lambda: "three active states; seen %r" % seen)
     seen.discard(None)
     assert len(seen) >= 3, seen
     assert all(node.startswith("s:/SM_ROOT/") for node in seen)

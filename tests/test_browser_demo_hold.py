@@ -7,7 +7,8 @@ from __future__ import annotations
 import os
 
 import pytest
-from browser_support import CHROMIUM, DemoProcess, launch_chromium, open_page
+from server.testing.browser import CHROMIUM, launch_chromium, open_page
+from server.testing.demo_process import DemoProcess
 
 
 @pytest.fixture

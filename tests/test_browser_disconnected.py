@@ -7,9 +7,9 @@ import signal
 
 import fsm
 import pytest
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from server.http_server import ServerThread
-from server_support import wait_for
+from server.testing.polling import wait_for
 from test_publisher_lifecycle import publish, remote
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import fsm
 import pytest
-from browser_support import browser, filter_log, watch  # noqa: F401 (browser is a fixture)
+from browser_support import filter_log, watch
 from server.http_server import ServerThread
 
 

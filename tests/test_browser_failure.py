@@ -7,7 +7,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from server.http_server import ServerThread
 
 ERROR_RED = "rgb(198, 40, 40)"  # --err of static/style.css

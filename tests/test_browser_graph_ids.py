@@ -7,7 +7,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from fsm.observation.schema import edge_id, state_id
 from server.http_server import ServerThread
 

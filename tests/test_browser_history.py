@@ -7,10 +7,10 @@ import threading
 
 import fsm
 import pytest
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from server.hub import HISTORY
 from server.http_server import ServerThread
-from server_support import wait_for
+from server.testing.polling import wait_for
 
 
 def gated_machine(gate: threading.Event):

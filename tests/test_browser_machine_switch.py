@@ -5,7 +5,7 @@ from __future__ import annotations
 import threading
 
 import fsm
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from server_support import Stubborn
 
 

@@ -6,7 +6,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from server.http_server import ServerThread
 
 SUB = "/SM_ROOT/SUB"

@@ -8,7 +8,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import browser, watch  # noqa: F401 (browser is a fixture)
+from browser_support import watch
 from server_support import Stubborn
 from server.http_server import ServerThread
 

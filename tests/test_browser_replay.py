@@ -11,7 +11,9 @@ import time
 
 import fsm
 import pytest
-from browser_support import ACTIVE_LEAF, CHROMIUM, ROOT, launch_chromium, open_page
+from browser_support import ACTIVE_LEAF, ROOT
+from server.testing.browser import CHROMIUM, launch_chromium, open_page
+from server.testing.polling import wait_for
 
 
 def record_slow_machine(path) -> None:
@@ -66,10 +68,12 @@ def replay_page(replay_url):
 @pytest.mark.timeout(60)
 def test_a_replayed_run_plays_in_the_dashboard_as_a_view_only_replay(replay_page):
     seen = set()
-    deadline = time.monotonic() + 10
-    while time.monotonic() < deadline and not {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen:
+
+    def b_and_c_seen() -> bool:
         seen.add(replay_page.evaluate(ACTIVE_LEAF))
-        time.sleep(0.05)
+        return {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen
+
+    wait_for(b_and_c_seen, 10, interval=0.05, what=lambda: "B and C active in turn; seen %r" % seen)
     assert {"s:/SM_ROOT/B", "s:/SM_ROOT/C"} <= seen, seen
     assert replay_page.text_content("#badge .badge-text").startswith("replay")
     assert replay_page.is_disabled("#preempt-btn")

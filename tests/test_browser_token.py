@@ -9,7 +9,6 @@ import threading
 
 import pytest
 
-from browser_support import browser  # noqa: F401  (the module's Chromium)
 from server.http_server import ServerThread
 from server_support import two_state_machine
 

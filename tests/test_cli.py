@@ -8,13 +8,13 @@ import signal
 import subprocess
 import sys
 import threading
-import time
 
 import httpx
 import pytest
 from fsm.observation.encoding import dumps
 
 from recording_support import EXAMPLES, FAST, ROOT, cli
+from server.testing.polling import wait_for
 
 
 @pytest.fixture(scope="module")
@@ -172,12 +172,13 @@ def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(
     threading.Thread(target=lambda: [lines.put(line) for line in proc.stderr], daemon=True).start()
 
     def line_matching(pattern):
-        deadline = time.monotonic() + 30
-        while time.monotonic() < deadline:
-            found = re.search(pattern, lines.get(timeout=max(0.01, deadline - time.monotonic())))
-            if found:
-                return found
-        raise AssertionError("no line matching %r" % pattern)
+        def next_line_matches():
+            try:
+                return re.search(pattern, lines.get(timeout=0.05))
+            except queue.Empty:
+                return None
+
+        return wait_for(next_line_matches, 30, interval=0, what="a line matching %r" % pattern)
 
     try:
         base, token = line_matching(r"dashboard at (http://[^/]+)/\?token=(\S+)").groups()
@@ -185,13 +186,12 @@ def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(
         http = httpx.Client(base_url=base, headers={"Authorization": "Bearer " + token}, timeout=10)
         first_run = http.get("/api/machines/foo_bar/status").json()["run"]
         assert http.post("/api/machines/foo_bar/start", json={}).status_code == 202
-        deadline = time.monotonic() + 10
-        while True:
+
+        def the_new_run_ended():
             status = http.get("/api/machines/foo_bar/status").json()
-            if status["run"] != first_run and not status["running"] and status["outcome"] == "end":
-                break
-            assert time.monotonic() < deadline
-            time.sleep(0.02)
+            return status["run"] != first_run and not status["running"] and status["outcome"] == "end"
+
+        wait_for(the_new_run_ended, 10, interval=0.02, what="the run started from the dashboard to end")
         proc.send_signal(signal.SIGINT)
         assert proc.wait(20) == 0
     finally:

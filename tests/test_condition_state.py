@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import eventually
+from server.testing.polling import wait_for
 from fsm.ros.condition_state import ConditionState
 from smach_support import Background, machine
 
@@ -77,7 +77,7 @@ def test_preempt_during_the_poll_sleep_gives_preempted_at_once():
     cond = Counting()
     state = ConditionState(cond, poll_rate=10.0, max_checks=-1)
     run = Background(lambda: state.execute(smach.UserData()))
-    assert eventually(lambda: cond.calls == 1)
+    wait_for(lambda: cond.calls == 1)
     t0 = time.monotonic()
     state.request_preempt()
     assert run.join(1.0) == "preempted"

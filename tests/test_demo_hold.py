@@ -14,7 +14,7 @@ from test_demo_process import api, wait_for_machine
 @pytest.fixture
 def demo(tmp_path):
     """The demo at real time: episodes of several seconds with a pause of 1 s between them."""
-    from browser_support import DemoProcess
+    from server.testing.demo_process import DemoProcess
 
     demo = DemoProcess(tmp_path / "demo.jsonl")
     yield demo

@@ -12,6 +12,7 @@ import time
 
 import pytest
 from browser_support import ROOT
+from server.testing.polling import wait_for
 
 FSMSCOPE = [sys.executable, "-m", "server.cli"]
 
@@ -23,12 +24,8 @@ def start_headless_demo(record) -> subprocess.Popen:
 
 def wait_until_running(record, timeout: float = 60.0) -> None:
     """Until the log holds a first transition (the arm is moving)."""
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if record.exists() and '"kind":"transition"' in record.read_text():
-            return
-        time.sleep(0.2)
-    raise TimeoutError("the demo never started moving")
+    wait_for(lambda: record.exists() and '"kind":"transition"' in record.read_text(), timeout, interval=0.2,
+             what="the demo to start moving")
 
 
 @pytest.mark.timeout(120)
@@ -57,18 +54,16 @@ def api(demo, method: str, path: str, body: dict | None = None) -> tuple[int, di
 
 
 def wait_for_machine(demo, predicate, timeout: float = 30.0) -> dict:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
+    def pick_place_as_wanted() -> dict | None:
         machine = {m["name"]: m for m in api(demo, "GET", "/api/machines")[1]}.get("pick_place")
-        if machine is not None and predicate(machine):
-            return machine
-        time.sleep(0.1)
-    raise TimeoutError("pick_place never reached the expected state")
+        return machine if machine is not None and predicate(machine) else None
+
+    return wait_for(pick_place_as_wanted, timeout, interval=0.1, what="pick_place to reach the expected state")
 
 
 @pytest.mark.timeout(120)
 def test_preempting_the_demo_halts_the_episode_and_start_runs_the_next(tmp_path):
-    from browser_support import DemoProcess
+    from server.testing.demo_process import DemoProcess
 
     demo = DemoProcess(tmp_path / "demo.jsonl")
     try:

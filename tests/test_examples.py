@@ -11,6 +11,7 @@ from fsm.logfiles.log_reader import read_events
 from fsm.logfiles.summary import summarize
 
 from recording_support import EXAMPLES, FAST, cli, load_example, record
+from server.testing.polling import wait_for
 
 
 def test_foo_bar_loops_three_times_then_ends_in_end(tmp_path):
@@ -61,12 +62,14 @@ def test_nested_monitor_is_preempted_by_a_message_from_outside():
     runner.start()
     try:
         assert started.wait(5)
+
         # the monitor subscribes as the Concurrence starts its children: publish until it listens
-        for _ in range(200):
+        def stopped_by_a_message() -> bool:
             get_bus().publish("sm_stop", {"reason": "test"})
             runner.join(0.02)
-            if result:
-                break
+            return bool(result)
+
+        wait_for(stopped_by_a_message, 4.0, interval=0, what="the machine to end on an sm_stop message")
     finally:
         runner.join(5)
         server.shutdown()

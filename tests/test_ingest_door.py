@@ -10,7 +10,8 @@ import pytest
 from websockets.sync.client import connect
 
 from event_support import deep_root, ev, flat_root, run_of
-from server_support import client, frames, stream, wait_for
+from server.testing.polling import wait_for
+from server_support import client, frames, stream
 
 
 @pytest.fixture

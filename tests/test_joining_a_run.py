@@ -8,7 +8,8 @@ import time
 
 import fsm
 
-from server_support import Stubborn, client, frames, stream, wait_for, waiting_machine
+from server.testing.polling import wait_for
+from server_support import Stubborn, client, frames, stream, waiting_machine
 
 
 def test_a_client_joining_mid_run_gets_the_runs_events_so_far_with_its_snapshot(live_server):

@@ -4,7 +4,8 @@ import time
 
 import fsm as smach
 
-from bus_support import bus, eventually  # noqa: F401 (fixture)
+from bus_support import bus  # noqa: F401 (fixture)
+from server.testing.polling import wait_for
 from fsm.ros.monitor_state import MonitorState
 from smach_support import Background, machine
 
@@ -12,7 +13,7 @@ from smach_support import Background, machine
 def run_monitor(bus, state) -> Background:
     """Run a state (with empty userdata) or a machine in a thread; return once it has subscribed."""
     run = Background(state.execute if isinstance(state, smach.StateMachine) else lambda: state.execute(smach.UserData()))
-    assert eventually(lambda: "t" in bus.topics())
+    wait_for(lambda: "t" in bus.topics())
     return run
 
 

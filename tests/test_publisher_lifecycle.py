@@ -11,7 +11,8 @@ import sys
 import textwrap
 
 from browser_support import ROOT
-from server_support import client, wait_for
+from server.testing.polling import wait_for
+from server_support import client
 
 SCRIPT = textwrap.dedent("""
     import sys, time

@@ -8,7 +8,8 @@ import fsm
 import httpx
 from fsm.ros.bus import default_bus
 
-from server_support import client, nested_machine, two_state_machine, wait_for, waiting_machine
+from server.testing.polling import wait_for
+from server_support import client, nested_machine, two_state_machine, waiting_machine
 
 
 def run_in_thread(sm):

@@ -9,7 +9,9 @@ from fsm.observation.status import Status
 
 from recording_support import two_state_loop
 from server import hub as hub_module
-from server_support import blob_loop, events_of, frames, stalled_stream, stream, two_state_machine, wait_for
+from server.testing.clients import stalled_stream
+from server.testing.polling import wait_for
+from server_support import blob_loop, events_of, frames, stream, two_state_machine
 
 
 def has_terminate(got):
@@ -56,16 +58,17 @@ def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
     try:
         wait_for(lambda: len(entry.clients) == 1)
         [client] = list(entry.clients)
+
         # Fill the socket buffers until a send blocks: one that started and is still not done 0.2 s
         # later (a send that merely happened to be under way would finish and wake the client again).
-        while True:
+        def a_send_stays_blocked() -> bool:
             started = client.send_started
             if started is None:
                 sm.execute()
-            elif time.monotonic() - started < 0.2:
-                time.sleep(0.05)
-            else:
-                break
+                return False
+            return time.monotonic() - started >= 0.2
+
+        wait_for(a_send_stays_blocked, 60, interval=0.05)
         counting = client.wake = CountingEvent()
         for _ in range(5):
             sm.execute()  # 5 x 3,000 more events

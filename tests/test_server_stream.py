@@ -10,8 +10,10 @@ from websockets.sync.client import connect
 
 from server import hub as hub_module
 from server.publisher import Publisher
-from server_support import (blob_loop, client, events_of, frames, nested_machine, stalled_stream, stream,
-                            two_state_machine, wait_for, waiting_machine)
+from server.testing.clients import stalled_stream
+from server.testing.polling import wait_for
+from server_support import (blob_loop, client, events_of, frames, nested_machine, stream, two_state_machine,
+                            waiting_machine)
 
 
 def has_terminate(got):

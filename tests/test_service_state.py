@@ -7,7 +7,8 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus, eventually  # noqa: F401 (fixture)
+from bus_support import bus  # noqa: F401 (fixture)
+from server.testing.polling import wait_for
 from fsm.ros.bus import default_bus
 from fsm.ros.service_state import ServiceState
 from smach_support import Background, machine, userdata
@@ -181,7 +182,7 @@ def test_waits_for_a_service_that_comes_up_later(bus):
 def test_preempt_while_waiting_for_the_service_gives_preempted_at_once(bus, logs):
     state = ServiceState("missing", bus=bus)
     run = Background(lambda: state.execute(userdata()))
-    assert eventually(lambda: logs.warn)
+    wait_for(lambda: logs.warn)
     t0 = time.monotonic()
     state.request_preempt()
     assert run.join(1.0) == "preempted"

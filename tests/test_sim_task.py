@@ -20,6 +20,7 @@ pytest.importorskip("mujoco")
 import fsm  # noqa: E402
 from fsm.ros.actionlib import GoalStatus, SimpleActionClient  # noqa: E402
 from fsm.ros.bus import Bus  # noqa: E402
+from server.testing.polling import wait_for  # noqa: E402
 
 from sim.demo import SimDemo  # noqa: E402
 from sim.ik import IKSolver, tool_down_rotation  # noqa: E402
@@ -154,10 +155,9 @@ def _preempt_during_transport(d, preempt):
     machine = d.build_machine()
     runner = threading.Thread(target=lambda: out.update(outcome=machine.execute()))
     runner.start()
-    deadline = time.monotonic() + 30.0
-    while w.label != "PLACE/TRANSPORT":
-        assert time.monotonic() < deadline and runner.is_alive(), w.label
-        time.sleep(0.002)
+    wait_for(lambda: w.label == "PLACE/TRANSPORT" or not runner.is_alive(), 30.0, interval=0.002,
+             what=lambda: "PLACE/TRANSPORT; the arm is at " + w.label)
+    assert w.label == "PLACE/TRANSPORT", w.label  # not an episode that ended before transporting
     t_transport = w.time
     w.sleep(0.5)
     speed_before = float(np.max(np.abs(w.arm_qvel())))

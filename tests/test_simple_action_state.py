@@ -7,7 +7,8 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus, eventually, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from bus_support import bus, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from server.testing.polling import wait_for
 from fsm.ros.actionlib import GoalStatus
 from fsm.ros.simple_action_state import SimpleActionState
 from smach_support import Background, machine, userdata
@@ -133,7 +134,7 @@ def test_preempt_cancels_the_goal_and_gives_preempted(bus, servers, logs):
     server = serve(bus, servers, lambda goal: until_preempted(server)(goal))
     s = state(bus)
     run = Background(lambda: s.execute(userdata()))
-    assert eventually(server.is_active)
+    wait_for(server.is_active)
     s.request_preempt()
     assert run.join(1.0) == "preempted"
     assert not s.preempt_requested()
@@ -178,7 +179,7 @@ def test_server_that_comes_up_late_is_used(bus, servers):
 def test_preempt_while_waiting_for_the_server_gives_preempted_at_once(bus, logs):
     s = state(bus, server_wait_timeout=10.0)
     run = Background(lambda: s.execute(userdata()))
-    assert eventually(lambda: logs.warn)
+    wait_for(lambda: logs.warn)
     t0 = time.monotonic()
     s.request_preempt()
     assert run.join(1.0) == "preempted"
@@ -190,7 +191,7 @@ def test_goal_that_ignores_its_cancel_is_left_after_preempt_timeout(bus, servers
     server = serve(bus, servers, lambda goal: (release.wait(2.0), server.set_succeeded()))
     s = state(bus, preempt_timeout=0.1)
     run = Background(lambda: s.execute(userdata()))
-    assert eventually(server.is_active)
+    wait_for(server.is_active)
     s.request_preempt()
     assert run.join(1.0) == "preempted"
     assert any("did not end within 0.1 seconds of its cancellation" in line for line in logs.warn)
@@ -231,7 +232,7 @@ def test_preempting_a_state_machine_cancels_the_running_goal(bus, servers):
     server = serve(bus, servers, lambda goal: until_preempted(server)(goal))
     sm = machine(["succeeded", "aborted", "preempted"], [("MOVE", state(bus), {})])
     run = Background(sm.execute)
-    assert eventually(server.is_active)
+    wait_for(server.is_active)
     sm.request_preempt()
     assert run.join(1.0) == "preempted"
 

@@ -16,8 +16,9 @@ import time
 
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
+from fsm.observation import structure  # noqa: E402
 from server import graph  # noqa: E402
-from server.hub import count_states, structure_hash  # noqa: E402
+from server.hub import structure_hash  # noqa: E402
 
 
 def leaf(parent, label):
@@ -51,7 +52,7 @@ SHAPES = {
 
 def measure(root, expand, repeat):
     key = structure_hash(root)
-    n = count_states(root)
+    n = structure.count(root)
     cold, cached, sizes, layouts = [], [], [], 0
     for _ in range(repeat):
         renderer = graph.Renderer()
@@ -74,7 +75,7 @@ def main():
     print("%-28s %-9s %7s %10s %12s %8s %9s  %s" % ("machine", "drawn", "states", "cold s", "cached ms",
                                                    "layouts", "SVG KB", "target"))
     for name, root in SHAPES.items():
-        all_open = [c["path"] for c in graph.containers(root)]
+        all_open = [c["path"] for c in structure.containers(root)]
         for label, expand in (("default", None), ("all open", all_open)):
             n, cold, cached, layouts, size = measure(root, expand, args.repeat)
             target = ("<0.5 s cold: %s" % ("met" if cold < 0.5 else "MISSED")) if n >= 1000 else ""

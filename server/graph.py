@@ -25,6 +25,7 @@ from typing import Iterable
 
 import pydot
 
+from fsm.observation import structure
 from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
 
 SVG_NS = "http://www.w3.org/2000/svg"
@@ -54,33 +55,15 @@ def q(text: str) -> str:
     return '"%s"' % str(text).translate(_VISIBLE).replace("\\", "\\\\").replace('"', '\\"')
 
 
-def containers(node: dict) -> Iterable[dict]:
-    if node.get("container"):
-        yield node
-        for child in node.get("children") or ():
-            yield from containers(child)
-
-
-def _count(node: dict) -> int:
-    return 1 + sum(_count(c) for c in node.get("children") or ())
-
-
 def open_set(root: dict, expand: Iterable[str] | None, n_states: int) -> frozenset[str]:
     """The containers drawn open: the root, and those named (whose parents are open too)."""
     if not expand:
         if n_states <= AUTO_OPEN_LIMIT:
-            return frozenset(c["path"] for c in containers(root))
+            return frozenset(c["path"] for c in structure.containers(root))
         return frozenset([root["path"]])
     wanted = set(expand) | {root["path"]}
-    visible: set[str] = set()
-
-    def walk(node: dict) -> None:
-        if node.get("container") and node["path"] in wanted:
-            visible.add(node["path"])
-            for child in node.get("children") or ():
-                walk(child)
-    walk(root)
-    return frozenset(visible)
+    reached = structure.containers(root, lambda c: c["path"] in wanted)
+    return frozenset(c["path"] for c in reached if c["path"] in wanted)
 
 
 def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
@@ -216,7 +199,7 @@ class Renderer:
 
     def render(self, root: dict, key: str, expand: Iterable[str] | None = None, n_states: int | None = None) -> bytes:
         if n_states is None:
-            n_states = _count(root)
+            n_states = structure.count(root)
         opened = open_set(root, expand, n_states)
         doc_key = (key, opened)
         with self._lock:
@@ -236,14 +219,9 @@ class Renderer:
 
     def _render(self, root: dict, key: str, opened: frozenset[str]) -> bytes:
         by_depth: dict[int, list[dict]] = collections.defaultdict(list)
-
-        def walk(node: dict, depth: int) -> None:
+        for node, depth in structure.walk(root, lambda c: c["path"] in opened):
             if node["path"] in opened:
                 by_depth[depth].append(node)
-                for child in node.get("children") or ():
-                    if child.get("container"):
-                        walk(child, depth + 1)
-        walk(root, 0)
         done: dict[str, tuple[ET.Element, float, float]] = {}
         for depth in sorted(by_depth, reverse=True):
             todo = []

@@ -51,25 +51,114 @@ export function valueText(value, max = 200) {
   return text.length > max ? text.slice(0, max) + "…" : text;
 }
 
-function lastStateOutcome(node, last, containerOutcome) {
-  // The terminate event carries the container outcome; the state's own outcome is the
-  // transition that leads there (the first, if several do).
-  for (const tr of node?.transitions || []) {
-    if (tr.from === last && (tr.to === containerOutcome || (tr.to === null && tr.outcome === containerOutcome))) {
-      return tr.outcome;
-    }
+const SERVICED_PREEMPT = "Concurrence serviced preempt.";
+const STATE_MACHINE_TYPES = ["StateMachine", "Sequence"];
+
+/** Python's str() of a JSON value: what SMACH's '%s' writes. */
+function pyS(value) {
+  return typeof value === "string" ? value : pyRepr(value);
+}
+
+function* walk(node) {
+  yield node;
+  for (const child of node.children || []) yield* walk(child);
+}
+
+/** The container class behind an event's path, from its structure node or, without one, guessed
+ * from the event (fsm/logfiles/structure_index.py's container_type: the same rules). */
+export function containerType(ev, node) {
+  if (node) {
+    const type = node.type ?? "StateMachine";
+    if (STATE_MACHINE_TYPES.includes(type) || type === "Concurrence" || type === "Iterator") return type;
+    if ("outcome_map" in node) return "Concurrence"; // subclasses keep their parent's fields
+    if ("exhausted_outcome" in node) return "Iterator";
+    return "StateMachine";
   }
-  return containerOutcome;
+  if (ev.kind === "transition" && (ev.to === null || ev.to === undefined)) return "Concurrence";
+  if (ev.kind === "terminate" && "outcomes" in ev) return "Concurrence";
+  if (ev.kind === "transition" && ev.from === ev.to) return "Iterator";
+  return "StateMachine";
 }
 
 /**
- * @param {object} ev an event
- * @param {(path: string) => object|undefined} nodeOf the structure node at a path
- * @returns {{level: string, text: string}}
+ * Events, fed one at a time in order, as the SMACH log lines they stand for: the lines of
+ * fsm/logfiles/transcript.py's Transcript, word for word (tests/test_browser_transcript.py
+ * compares them over a recorded run of every example). A Concurrence that logged
+ * "Concurrence serviced preempt." prints no "Concurrent Outcomes" line: that needs the events before.
  */
-export function transcript(ev, nodeOf = () => undefined) {
-  const node = nodeOf(ev.path);
-  const type = node?.type;
+export class Transcript {
+  /** @param {(path: string) => object|undefined} [nodeOf] the structure node at a path; without
+   * it, the structure comes from the events' own `structure` and `snapshot` events */
+  constructor(nodeOf) {
+    this.own = new Map(); // machine + "\n" + container path -> structure node (without nodeOf)
+    this.nodeOf = nodeOf ?? ((path, machine) => this.own.get(machine + "\n" + path));
+    this.indexing = !nodeOf;
+    this.serviced = new Set(); // machine + "\n" + path of the Concurrences that logged a serviced preempt
+  }
+
+  /** @returns {{level: string, text: string}[]} the lines the event stands for (none or one) */
+  lines(ev) {
+    if (this.indexing) this._index(ev);
+    const line = this._line(ev);
+    return line ? [line] : [];
+  }
+
+  /** The event log's row of the event: its SMACH line, or else a description of the event. */
+  row(ev) {
+    return this.lines(ev)[0] ?? description(ev);
+  }
+
+  _index(ev) {
+    const root = ev.kind === "structure" ? ev.root : ev.kind === "snapshot" ? ev.status?.structure : null;
+    if (!root) return;
+    for (const node of walk(root)) if (node.container) this.own.set(ev.machine + "\n" + node.path, node);
+  }
+
+  _line(ev) {
+    const key = ev.machine + "\n" + ev.path;
+    if (ev.kind === "log") {
+      if (ev.msg === SERVICED_PREEMPT) this.serviced.add(key);
+      return { level: ev.level || "info", text: String(ev.msg ?? "") };
+    }
+    if (ev.kind === "control") return controlLine(ev);
+    if (!["start", "transition", "terminate"].includes(ev.kind)) return null;
+    const type = containerType(ev, this.nodeOf(ev.path, ev.machine));
+    if (type === "Iterator") return null; // SMACH's Iterator prints only "Iterating ..." (a log event)
+    const info = (text) => ({ level: "info", text });
+    if (ev.kind === "start") {
+      this.serviced.delete(key);
+      const keys = pyRepr(Object.keys(ev.userdata || {}));
+      if (type === "Concurrence") return info("Concurrence starting with userdata: \n\t" + keys);
+      const initial = (ev.initial?.length ? ev.initial : ev.active?.length ? ev.active : ["None"])[0];
+      return info(`State machine starting in initial state '${pyS(initial)}' with userdata: \n\t${keys}`);
+    }
+    if (ev.kind === "transition") {
+      return type === "Concurrence"
+        ? info(`Concurrent state '${pyS(ev.from)}' returned outcome '${pyS(ev.outcome)}' on termination.`)
+        : info(`State machine transitioning '${pyS(ev.from)}':'${pyS(ev.outcome)}'-->'${pyS(ev.to)}'`);
+    }
+    if (ev.outcome === null || ev.outcome === undefined) return null; // the runtime logs failures itself
+    if (type === "Concurrence") {
+      return this.serviced.has(key) ? null : info("Concurrent Outcomes: " + pyRepr(ev.outcomes || {}));
+    }
+    const last = ev.last?.length ? ev.last[0] : "None";
+    const stateOutcome = "state_outcome" in ev ? ev.state_outcome : ev.outcome;
+    return info(`State machine terminating '${pyS(last)}':'${pyS(stateOutcome)}':'${pyS(ev.outcome)}'`);
+  }
+}
+
+function controlLine(ev) {
+  const reason = ev.reason ? ` (${ev.reason})` : "";
+  const params = ev.params && Object.keys(ev.params).length ? " " + valueText(ev.params, 120) : "";
+  const result = ev.result === "accepted" ? "accepted" : `refused: ${ev.result}`;
+  return {
+    level: ev.result === "accepted" ? "info" : "warn",
+    text: `Control ${ev.action ?? "?"}${params} from ${ev.client ?? "?"}${reason}: ${result}`,
+  };
+}
+
+/** An event that stands for no SMACH line, described for the event log. */
+function description(ev) {
   switch (ev.kind) {
     case "structure": {
       let n = 0;
@@ -77,29 +166,11 @@ export function transcript(ev, nodeOf = () => undefined) {
       if (ev.root) count(ev.root);
       return { level: "debug", text: `Structure of ${ev.path}: ${n} states` };
     }
-    case "start": {
-      const keys = pyRepr(Object.keys(ev.userdata || {}));
-      if (type === "Concurrence") return { level: "info", text: "Concurrence starting with userdata: \n\t" + keys };
-      if (type === "Iterator") return { level: "info", text: `Iterator starting with userdata: \n\t${keys}` };
-      const first = (ev.active && ev.active[0]) ?? (ev.initial && ev.initial[0]) ?? "None";
-      return { level: "info", text: `State machine starting in initial state ${pyStr(first)} with userdata: \n\t${keys}` };
-    }
-    case "transition":
-      if (ev.to === null || ev.to === undefined) {
-        return { level: "info", text: `Concurrent state ${pyStr(ev.from)} returned outcome ${pyStr(ev.outcome)} on termination.` };
-      }
-      return { level: "info", text: `State machine transitioning ${pyStr(ev.from)}:${pyStr(ev.outcome)}-->${pyStr(ev.to)}` };
-    case "terminate": {
+    case "terminate":
       if (ev.outcome === null || ev.outcome === undefined) {
         return { level: "error", text: `Container ${ev.path} ended without an outcome` + (ev.error ? `: ${ev.error}` : ".") };
       }
-      if (type === "Concurrence" || ev.outcomes) {
-        return { level: "info", text: "Concurrent Outcomes: " + pyRepr(ev.outcomes || {}) };
-      }
-      const last = (ev.last && ev.last[0]) ?? "None";
-      const outcome = lastStateOutcome(node, last, ev.outcome);
-      return { level: "info", text: `State machine terminating ${pyStr(last)}:${pyStr(outcome)}:${pyStr(ev.outcome)}` };
-    }
+      break;
     case "userdata":
       return {
         level: "debug",
@@ -114,20 +185,19 @@ export function transcript(ev, nodeOf = () => undefined) {
         level: "error",
         text: `State ${pyStr(ev.state ?? "None")} failed to execute. ${ev.exc_type ?? "Error"}: ${ev.message ?? ""}`,
       };
-    case "log":
-      return { level: ev.level || "info", text: String(ev.msg ?? "") };
     case "feedback":
       return { level: "debug", text: `Feedback (${ev.action ?? "action"}): ${valueText(ev.feedback, 160)}` };
-    case "control": {
-      const reason = ev.reason ? ` (${ev.reason})` : "";
-      const params = ev.params && Object.keys(ev.params).length ? " " + valueText(ev.params, 120) : "";
-      const result = ev.result === "accepted" ? "accepted" : `refused: ${ev.result}`;
-      return {
-        level: ev.result === "accepted" ? "info" : "warn",
-        text: `Control ${ev.action ?? "?"}${params} from ${ev.client ?? "?"}${reason}: ${result}`,
-      };
-    }
-    default:
-      return { level: "debug", text: `${ev.kind} ${ev.path}` };
   }
+  return { level: "debug", text: `${ev.kind} ${ev.path}` };
+}
+
+/**
+ * An event log row's text, from the event alone: a Concurrence's terminate after a serviced
+ * preempt still reads "Concurrent Outcomes" here (Transcript#row, fed every event, knows better).
+ * @param {object} ev an event
+ * @param {(path: string) => object|undefined} nodeOf the structure node at a path
+ * @returns {{level: string, text: string}}
+ */
+export function transcript(ev, nodeOf = () => undefined) {
+  return new Transcript(nodeOf).row(ev);
 }

@@ -1,0 +1,106 @@
+"""The browser's transcript (static/transcript.js) is the terminal's (fsm.logfiles.transcript), line for line.
+
+Both rebuild SMACH's log lines from the same events; the Python side is checked against the
+runtime's own printed lines (tests/test_transcript.py). Here each example is recorded as
+``fsmscope run --record`` records it, plus three machines for what no example does (an Iterator,
+a Concurrence that services a preempt, two outcomes of the last state leading to one container
+outcome), and the events of each run are fed to both, in Chromium for the JavaScript.
+"""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import fsm
+import pytest
+from fsm.logfiles.log_reader import read_events
+from fsm.logfiles.transcript import Transcript
+
+from recording_support import EXAMPLES, FAST, cli, record
+from smach_support import Out, WaitForPreempt, concurrence, machine
+
+STATIC = Path(__file__).resolve().parents[1] / "static"
+ORIGIN = "http://transcript.test"
+
+
+def iterator_run(path: Path) -> None:
+    """SM_ROOT: IT iterates BODY over three items, then the machine ends 'done'."""
+    it = fsm.Iterator(outcomes=["done"], input_keys=[], output_keys=[], it=[1, 2, 3], it_label="item")
+    with it:
+        fsm.Iterator.set_contained_state("BODY", Out("next"), loop_outcomes=["next"])
+    record(machine(["done"], [("IT", it, {"exhausted": "done"})]), path)
+
+
+def serviced_preempt_run(path: Path) -> None:
+    """SM_ROOT: CC (two children that service a preempt) is preempted from outside and ends 'preempted'."""
+    left, right = WaitForPreempt(), WaitForPreempt()
+    cc = concurrence(["preempted", "done"], "done", [("LEFT", left), ("RIGHT", right)])
+    sm = machine(["stopped", "done"], [("CC", cc, {"preempted": "stopped", "done": "done"})])
+
+    def preempt_once_running():
+        assert left.started.wait(5) and right.started.wait(5)
+        sm.request_preempt()
+    preempter = threading.Thread(target=preempt_once_running)
+    preempter.start()
+    outcome, _ = record(sm, path)
+    preempter.join(5)
+    assert outcome == "stopped"
+
+
+def two_outcomes_to_one_run(path: Path) -> None:
+    """A returns 'b'; both its outcomes lead to 'done': the last line names 'b', the outcome A returned."""
+    record(machine(["done"], [("A", Out("b", outcomes=["a", "b"]), {"a": "done", "b": "done"})]), path)
+
+
+def example_run(name: str):
+    def run(path: Path) -> None:
+        done = cli("run", Path(EXAMPLES) / (name + ".py"), "--record", path, env=FAST)
+        assert done.returncode == 0, done.stderr
+    return run
+
+
+RUNS = {**{p.stem: example_run(p.stem) for p in sorted(Path(EXAMPLES).glob("*.py"))},
+        "iterator": iterator_run, "concurrence_serviced_preempt": serviced_preempt_run,
+        "two_outcomes_to_one": two_outcomes_to_one_run}
+
+
+@pytest.fixture(scope="module")
+def page(browser):
+    """A blank page that can import the static modules (served from disk, no server)."""
+    def serve(route):
+        name = route.request.url[len(ORIGIN) + 1:]
+        if name.endswith(".js"):
+            route.fulfill(content_type="text/javascript", body=(STATIC / name).read_text())
+        else:
+            route.fulfill(content_type="text/html", body="")
+
+    page = browser.new_page()
+    page.route(ORIGIN + "/**", serve)
+    page.goto(ORIGIN + "/")
+    yield page
+    page.close()
+
+
+def terminal_lines(events: list[dict]) -> list[tuple]:
+    transcript = Transcript()
+    return [(e["seq"], e["kind"], line.level, line.msg) for e in events for line in transcript.lines(e)]
+
+
+def browser_lines(page, events: list[dict]) -> list[tuple]:
+    lines = page.evaluate("""async (events) => {
+        const { Transcript } = await import('/transcript.js');
+        const transcript = new Transcript();
+        return events.flatMap((e) => transcript.lines(e).map((line) => [e.seq, e.kind, line.level, line.text]));
+    }""", events)
+    return [tuple(line) for line in lines]
+
+
+@pytest.mark.parametrize("name", RUNS)
+def test_the_browsers_transcript_of_a_run_is_the_terminals_line_for_line(page, tmp_path, name, logs):
+    path = tmp_path / (name + ".jsonl")
+    RUNS[name](path)
+    events = list(read_events(path))
+    want = terminal_lines(events)
+    assert want
+    assert browser_lines(page, events) == want

@@ -10,6 +10,7 @@ import threading
 from typing import Any, Callable
 
 from fsm import introspection
+from fsm.observation import structure
 
 
 LAST_RUN_GRACE = 1.0  # seconds a start waits for this handle's previous run to return
@@ -109,13 +110,7 @@ class MachineHandle:
             return self.machine
         if not path.startswith(root_path + "/"):
             return None
-        state = self.machine
-        for label in path[len(root_path) + 1:].split("/"):
-            children = state.get_children() if hasattr(state, "get_children") else None
-            if not children or label not in children:
-                return None
-            state = children[label]
-        return state
+        return structure.state_at(self.machine, path[len(root_path) + 1:].split("/"))
 
     def set_initial_state(self, path: str | None, states: list[str], userdata: dict | None, client: str) -> int:
         path = path or self.reporter.root_path
@@ -124,7 +119,7 @@ class MachineHandle:
             container = self.container_at(path)
             if container is None:
                 raise ControlError(404, "no state at path %r" % path)
-            if not hasattr(container, "get_children"):
+            if not structure.is_container(container):
                 raise ControlError(422, "%r is a state, not a container" % path)
             self._check_states(container, states)
         except ControlError as err:
@@ -149,7 +144,7 @@ class MachineHandle:
             raise ControlError(422, "unknown states %s in %s (states: %s)" % (unknown, kind, sorted(children)))
         if not states:
             return
-        if hasattr(container, "_outcome_map") and hasattr(container, "_default_outcome"):  # Concurrence
+        if structure.is_concurrence(container):
             raise ControlError(422, "a Concurrence starts all its children; it takes no initial states")
         if len(states) > 1:
             raise ControlError(422, "a %s has exactly one initial state" % kind)

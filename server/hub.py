@@ -28,6 +28,7 @@ import time
 from typing import Any, Callable
 
 from fsm import introspection, schema
+from fsm.observation import structure
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 
@@ -44,12 +45,6 @@ _FRAME_TAIL = b"]}"
 
 def structure_hash(root: dict | None) -> str:
     return hashlib.blake2b(dumps(root), digest_size=12).hexdigest() if root is not None else ""
-
-
-def count_states(node: dict | None) -> int:
-    if not node:
-        return 0
-    return 1 + sum(count_states(c) for c in node.get("children", ()))
 
 
 class Client:
@@ -134,7 +129,7 @@ class MachineEntry:
         if id(root) != self._structure_id:
             self._structure_id = id(root)
             self._structure_hash = structure_hash(root)
-            self._n_states = count_states(root)
+            self._n_states = structure.count(root)
         return self._structure_hash, self._n_states
 
     def status_dict(self) -> dict:

@@ -5,5 +5,5 @@ Modules (each imports mujoco/viser only when used; nothing needs a display):
 ``world`` (model, seeded episodes, physics thread), ``ik`` (damped least squares),
 ``servers`` (MoveTo and Gripper action servers), ``task`` (``build_task_machine``),
 ``scene`` (``start_scene``: the viser view through mjviser), ``demo`` (``SimDemo``,
-``run_episodes``, ``main`` for ``fsmscope demo``).
+``run_episodes``: what ``fsmscope demo`` runs).
 """

@@ -1,10 +1,8 @@
-"""``fsmscope demo``: the pick-and-place machine running episodes on the simulated arm.
+"""The demo's simulation: the pick-and-place machine running episodes on the simulated arm.
 
-With the dashboard (the default), one URL shows the graph, the 3D arm, userdata and the
-event log; every episode is a run of the same machine, recorded to one log. A preempt
-(the dashboard's button, ``POST .../preempt`` or a message on ``sm_stop``) stops the arm
-and ends the episode 'preempted'; the loop then waits for Start. ``--headless`` runs with
-no server and no 3D view, for CI and post-mortems (``fsmscope replay`` reads its log).
+``SimDemo`` wires the world, the action servers and the 3D view together; ``run_episodes``
+is the loop (reset, build or reuse the machine, execute, wait for a start after a preempt).
+``fsmscope demo`` (server/cli/demo.py) adds the recording and the dashboard.
 
 For embedding::
 
@@ -16,10 +14,6 @@ For embedding::
 
 from __future__ import annotations
 
-import argparse
-import os
-import signal
-import sys
 import threading
 import time
 from typing import TYPE_CHECKING, Any, Callable
@@ -28,7 +22,6 @@ if TYPE_CHECKING:
     from .world import World
 
 Machine = Any
-MACHINE_NAME = "pick_place"
 
 
 def run_episodes(world: World, machine_factory: Callable[[World], Machine], episodes: int,
@@ -170,114 +163,3 @@ class SimDemo:
                 s.server.shutdown(timeout=2.0)
         self.world.stop()
 
-
-def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--headless", action="store_true", help="no dashboard, no 3D view: episodes and a recording only")
-    p.add_argument("--episodes", type=int, default=0, help="episodes to run (0: until stopped)")
-    p.add_argument("--record", metavar="FILE", help="the log of every episode (default: runs/demo-<time>.jsonl)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the first episode")
-    p.add_argument("--fast", action="store_true", help="physics as fast as possible, not real time")
-    p.add_argument("--host", default="127.0.0.1", help="dashboard address (default 127.0.0.1; any other needs a token)")
-    p.add_argument("--port", type=int, default=0, help="dashboard port (0: a free one)")
-    p.add_argument("--token", default=os.environ.get("FSMSCOPE_TOKEN"),
-                   help="the dashboard's access token (default: $FSMSCOPE_TOKEN, else a random one)")
-    p.add_argument("--verbose", action="store_true", help="print the machine's info/debug log")
-
-
-def parse_args(argv: list[str] | None) -> argparse.Namespace:
-    p = argparse.ArgumentParser(prog="fsmscope demo", description="pick-and-place on a simulated arm")
-    add_arguments(p)
-    return p.parse_args(argv)
-
-
-def _quiet_loggers() -> None:
-    import fsm
-
-    def quiet(msg: object) -> None:
-        pass
-
-    fsm.set_loggers(quiet, lambda m: print("[  WARN ] : " + str(m), file=sys.stderr), quiet,
-                    lambda m: print("[ ERROR ] : " + str(m), file=sys.stderr))
-
-
-def _print_episode(info: dict) -> None:
-    print("episode {episode} seed {seed}: {outcome} (cube {cube_target_distance:.3f} m from target, "
-          "{attempts} attempt(s), {sim_time:.1f} s simulated, {wall_time:.2f} s wall)".format(**info), flush=True)
-
-
-def main(argv: list[str] | None = None) -> int:
-    args = parse_args(argv)
-    return run_demo(args)
-
-
-def run_demo(args: argparse.Namespace) -> int:
-    """Physics, action servers, the task machine, its recording, and unless headless the dashboard
-    with the 3D view; until the episodes are done, Ctrl-C or SIGTERM. Everything is undone on exit."""
-    import fsm
-    from fsm.logfiles.recorder import Recorder
-
-    if not args.verbose:
-        _quiet_loggers()
-    record_path = args.record or os.path.join("runs", time.strftime("demo-%Y%m%d-%H%M%S.jsonl"))
-    os.makedirs(os.path.dirname(os.path.abspath(record_path)), exist_ok=True)
-    demo = SimDemo(seed=args.seed, fast=args.fast, scene=not args.headless)
-    machine = demo.build_machine()
-    recorder = Recorder(record_path)
-    fsm.attach(machine, recorder, name=MACHINE_NAME)
-    resume = threading.Event()
-    hold = threading.Event()
-    server = None
-    try:
-        if not args.headless:
-            from server.introspection_server import ServerThread
-
-            server = ServerThread(host=args.host, port=args.port, token=args.token or None,
-                                  scene_url=demo.scene.url if demo.scene is not None else None).start()
-            server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set)
-            print("fsmscope demo: open %s" % server.url, flush=True)
-        print("fsmscope demo: recording to %s" % record_path, flush=True)
-    except BaseException:
-        demo.close()
-        recorder.close()
-        raise
-
-    interrupted: list[int] = []
-
-    def on_signal(signum: int, frame: Any) -> None:
-        interrupted.append(signum)
-        demo.request_stop()
-
-    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
-    results: list[dict] = []
-    failure: list[BaseException] = []
-
-    def work() -> None:
-        try:
-            results.extend(demo.run(args.episodes, on_episode=_print_episode, machine_factory=lambda world: machine,
-                                    resume=None if server is None else resume, hold=hold))
-        except BaseException as exc:  # reported below, after cleanup
-            failure.append(exc)
-
-    worker = threading.Thread(target=work, name="sim-episodes", daemon=True)
-    worker.start()
-    try:
-        while worker.is_alive():
-            worker.join(0.2)
-    finally:
-        demo.close()
-        worker.join(5.0)
-        if server is not None:
-            server.stop()
-        recorder.close()
-        for s, h in old.items():
-            signal.signal(s, h)
-    print("fsmscope demo: %d episode(s) recorded to %s" % (len(results), record_path), flush=True)
-    if failure:
-        raise failure[0]
-    if interrupted:
-        return 128 + interrupted[0]  # as a shell reports a process ended by that signal: 130 Ctrl-C, 143 SIGTERM
-    return 0 if results and all(r["outcome"] == "succeeded" for r in results) else 1
-
-
-if __name__ == "__main__":
-    sys.exit(main())

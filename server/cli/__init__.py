@@ -1,0 +1,73 @@
+"""The ``fsmscope`` command line: the one place where fsmscope's parts are put together.
+
+Each subcommand is a module of this package that composes the components for one use: the
+runtime (``fsm``), the recorder, the script runner (``server.runner``), the dashboard's server
+(``server.http_server.ServerThread`` and its hub) and the simulator (``sim``). Nothing else in
+``server`` imports ``sim``, and ``sim`` never imports ``server``.
+
+A subcommand module has::
+
+    HELP = "serve the dashboard"        # one line, for ``fsmscope --help``
+    PASSES_ARGUMENTS_ON = False         # True: arguments it does not know go to ``args.extra`` (for a script)
+    def arguments(parser) -> None: ...  # its options
+    def main(args) -> int: ...          # the exit code; import fastapi, uvicorn, sim in here, not at module level
+
+To add one, write the module and list it in ``SUBCOMMANDS``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Protocol
+
+from . import demo, replay, run, serve
+from .serving import CannotServe
+
+
+class Subcommand(Protocol):
+    HELP: str
+    PASSES_ARGUMENTS_ON: bool
+
+    def arguments(self, parser: argparse.ArgumentParser) -> None: ...
+
+    def main(self, args: argparse.Namespace) -> int: ...
+
+
+SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "demo": demo}
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="fsmscope", description="Run, watch, record and replay SMACH-style state machines.")
+    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    commands.required = True
+    for name, sub in SUBCOMMANDS.items():
+        sub.arguments(commands.add_parser(name, help=sub.HELP, description=sub.HELP))
+    return parser
+
+
+def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
+    """For a subcommand that passes arguments on (to a script): its own arguments, and those after
+    the first '--', as they are. argparse cannot be left to it: it keeps that '--' among the
+    unknown arguments or drops it, depending on what precedes it (and on the Python version)."""
+    if argv and argv[0] in SUBCOMMANDS and SUBCOMMANDS[argv[0]].PASSES_ARGUMENTS_ON and "--" in argv:
+        cut = argv.index("--")
+        return argv[:cut], argv[cut + 1:]
+    return argv, []
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    own, passed_on = _split_passed_on(sys.argv[1:] if argv is None else list(argv))
+    args, extra = parser.parse_known_args(own)
+    if extra and not SUBCOMMANDS[args.command].PASSES_ARGUMENTS_ON:
+        parser.error("unrecognized arguments: %s" % " ".join(extra))
+    args.extra = extra + passed_on
+    try:
+        return SUBCOMMANDS[args.command].main(args)
+    except CannotServe as exc:
+        print("fsmscope %s: %s" % (args.command, exc), file=sys.stderr)
+        return 1
+    except BrokenPipeError:  # `fsmscope replay run.jsonl | head`
+        sys.stderr.close()
+        return 0

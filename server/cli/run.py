@@ -1,0 +1,57 @@
+"""``fsmscope run FILE.py``: the user's script run with recording (``server.runner.Runner``) and,
+unless ``--no-serve``, every machine it runs shown on the dashboard, where it can be started again."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import TYPE_CHECKING
+
+from .serving import add_server_arguments, start_server, wait_for_interrupt
+
+if TYPE_CHECKING:
+    from ..runner import Runner
+
+HELP = "run a SMACH-style script and record every machine it executes"
+PASSES_ARGUMENTS_ON = True
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("script", metavar="FILE.py",
+                        help="a SMACH-style script, run as __main__; arguments fsmscope does not know, and "
+                             "all after '--', are passed to it")
+    parser.add_argument("--record", metavar="RUN.jsonl",
+                        help="where to record the events (default: runs/<script>-<timestamp>.jsonl)")
+    parser.add_argument("--no-serve", action="store_true", help="do not serve the dashboard while it runs")
+    parser.add_argument("--exit", action="store_true",
+                        help="exit when the script ends instead of keeping the dashboard up")
+    add_server_arguments(parser, 0)
+
+
+def main(args: argparse.Namespace) -> int:
+    from ..runner import Runner
+
+    runner = Runner(args.script, list(args.extra), args.record)
+    if args.no_serve:
+        return runner.run()
+    return run_with_dashboard(args, runner)
+
+
+def run_with_dashboard(args: argparse.Namespace, runner: Runner) -> int:
+    """Serve every machine the script runs; keep serving afterwards unless --exit, or unless a
+    signal (Ctrl-C, SIGTERM) ended the script: one signal stops everything."""
+    srv = start_server(args)
+    hub = srv.hub
+    runner.on_machine.append(lambda name, container: hub.add_local(container, name=name, can_start=True))
+    runner.keep_open = True  # runs started from the dashboard after the script ends are recorded too
+    print("fsmscope: dashboard at %s" % srv.url, file=sys.stderr, flush=True)
+    try:
+        code = runner.run()
+        if not args.exit and runner.signalled is None:
+            print("fsmscope: the script ended (exit code %d); still serving at %s (Ctrl-C stops)"
+                  % (code, srv.url), file=sys.stderr, flush=True)
+            wait_for_interrupt()
+    finally:
+        srv.stop()
+        runner.close()
+    return code

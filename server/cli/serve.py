@@ -1,0 +1,27 @@
+"""``fsmscope serve``: a standalone dashboard that machines of other processes publish to
+(``server.publisher.Publisher`` posting to /api/ingest)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .serving import add_server_arguments, start_server, wait_for_interrupt
+
+HELP = "serve the dashboard for machines of other processes (they publish to /api/ingest)"
+PASSES_ARGUMENTS_ON = False
+DEFAULT_PORT = 8765
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    add_server_arguments(parser, DEFAULT_PORT)
+
+
+def main(args: argparse.Namespace) -> int:
+    srv = start_server(args)
+    print("fsmscope: serving the dashboard at %s" % srv.url, file=sys.stderr)
+    print("fsmscope: other processes publish with server.publisher.Publisher(%r, %r); Ctrl-C stops"
+          % (srv.base_url, srv.token), file=sys.stderr, flush=True)
+    wait_for_interrupt()
+    srv.stop()
+    return 0

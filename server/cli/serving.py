@@ -1,0 +1,45 @@
+"""What the commands that serve a dashboard share: the ``--host/--port/--token`` arguments, starting
+the server from them, and serving until Ctrl-C."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import threading
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from ..http_server import ServerThread
+
+
+class CannotServe(Exception):
+    """The server cannot start with these arguments (the port is taken, a public address has no
+    token): the command ends with exit code 1 and this reason."""
+
+
+def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> None:
+    parser.add_argument("--host", default="127.0.0.1",
+                        help="address to listen on (default 127.0.0.1; any other needs a token)")
+    parser.add_argument("--port", type=int, default=default_port,
+                        help="port (default %d%s)" % (default_port, "; 0 picks a free one" if default_port else
+                                                      ", a free one"))
+    parser.add_argument("--token", default=os.environ.get("FSMSCOPE_TOKEN"),
+                        help="the access token (default: $FSMSCOPE_TOKEN, else a random one per run)")
+
+
+def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
+    """The dashboard's server on ``--host/--port/--token``, started; ``options`` go to ``ServerThread``
+    (``scene_url``). Raises CannotServe."""
+    from ..http_server import ServerThread
+
+    try:
+        return ServerThread(host=args.host, port=args.port, token=args.token or None, **options).start()
+    except (ValueError, OSError) as exc:
+        raise CannotServe(str(exc)) from exc
+
+
+def wait_for_interrupt() -> None:
+    try:
+        threading.Event().wait()
+    except KeyboardInterrupt:
+        pass

@@ -60,7 +60,6 @@ class MachineHandle:
         self.starter = starter
         self.holder = holder
         self.held = False  # a hold was asked and no start has come since
-        self.observer: Any = None
         self._lock = threading.Lock()
         self._thread: threading.Thread | None = None
         self._pending: list[tuple[Any, list[str], dict | None]] = []

@@ -10,8 +10,8 @@ import socket
 import threading
 from typing import Any
 
+from .auth import check_bind, new_token
 from .hub import Hub
-from .security import check_bind, new_token
 
 
 def ws_implementation() -> str:

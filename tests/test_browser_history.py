@@ -8,7 +8,7 @@ import threading
 import fsm
 import pytest
 from browser_support import watch
-from server.hub import HISTORY
+from server.fanout import HISTORY
 from server.http_server import ServerThread
 from server.testing.polling import wait_for
 

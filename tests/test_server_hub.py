@@ -8,7 +8,7 @@ import fsm
 from fsm.observation.status import Status
 
 from recording_support import two_state_loop
-from server import hub as hub_module
+from server import fanout
 from server.testing.clients import stalled_stream
 from server.testing.polling import wait_for
 from server_support import blob_loop, events_of, frames, stream, two_state_machine
@@ -20,14 +20,14 @@ def has_terminate(got):
 
 def test_each_event_is_encoded_once_for_all_clients(live_server, monkeypatch):
     encoded = []
-    real = hub_module.dumps
+    real = fanout.dumps
 
     def counting(obj):
         if "seq" in obj and "kind" in obj:
             encoded.append(obj["seq"])
         return real(obj)
 
-    monkeypatch.setattr(hub_module, "dumps", counting)
+    monkeypatch.setattr(fanout, "dumps", counting)
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     sockets = [stream(live_server, "two") for _ in range(3)]
@@ -51,7 +51,7 @@ class CountingEvent(asyncio.Event):
 
 
 def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
-    monkeypatch.setattr(hub_module, "SEND_TIMEOUT", 60)
+    monkeypatch.setattr(fanout, "SEND_TIMEOUT", 60)
     sm = blob_loop(3000)
     entry = live_server.hub.add_local(sm, name="loop")
     raw = stalled_stream(live_server, "loop")
@@ -99,7 +99,7 @@ def test_a_blocked_loop_bounds_the_handoff_and_clients_end_with_the_true_status(
         try:
             assert sm.execute() == "done"
             assert entry.reporter.last_seq > 200_000
-            assert longest[0] <= hub_module.HANDOFF_LIMIT  # memory bounded while nobody drains
+            assert longest[0] <= fanout.HANDOFF_LIMIT  # memory bounded while nobody drains
             assert entry.status_dict()["outcome"] == "done"  # the hub's Status did not wait for the loop
         finally:
             release.set()

@@ -8,7 +8,7 @@ import pytest
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
-from server import hub as hub_module
+from server import fanout
 from server.publisher import Publisher
 from server.testing.clients import stalled_stream
 from server.testing.polling import wait_for
@@ -94,7 +94,7 @@ def test_stream_of_an_unknown_machine_is_refused_404(live_server):
 
 
 def test_a_client_that_falls_behind_gets_missed_then_a_snapshot(live_server, monkeypatch):
-    monkeypatch.setattr(hub_module, "CLIENT_QUEUE", 5)
+    monkeypatch.setattr(fanout, "CLIENT_QUEUE", 5)
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     with stream(live_server, "two") as ws:
@@ -115,8 +115,8 @@ def asyncio_set(srv, client):
 
 
 def test_a_stalled_client_is_dropped_and_the_machine_does_not_wait(live_server, monkeypatch):
-    monkeypatch.setattr(hub_module, "SEND_TIMEOUT", 0.5)
-    monkeypatch.setattr(hub_module, "CLIENT_QUEUE", 100000)
+    monkeypatch.setattr(fanout, "SEND_TIMEOUT", 0.5)
+    monkeypatch.setattr(fanout, "CLIENT_QUEUE", 100000)
     sm = blob_loop(20000)
     entry = live_server.hub.add_local(sm, name="loop")
     raw = stalled_stream(live_server, "loop")  # never read again

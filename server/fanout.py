@@ -1,0 +1,351 @@
+"""The fan-out: how a machine's events get from its thread to every browser that watches it.
+
+Threads: the machine's reporter calls the machine's ``Observer`` in the machine's thread. It
+applies the event to the ``Feed``'s Status there (under the feed's lock, so the Status is never
+behind the machine and never depends on the loop keeping up), encodes it, and appends the encoded
+event to the feed's bounded hand-off buffer; the ``Fanout`` wakes the event loop with
+``call_soon_threadsafe`` when no wake-up is pending. When the loop does not drain fast enough and
+the buffer holds ``HANDOFF_LIMIT`` events, the buffered events are dropped (counted): the ring then
+has a gap, and every client behind it is sent ``missed`` and a snapshot, taken from the Status,
+which is always complete. The loop owns the ring and the clients; it reads the Status under the lock.
+
+Every event is encoded once, into the machine's ring of recent events; a client is a cursor into
+that ring, so the per-event work on the loop does not depend on how many clients there are, and
+a client whose sender is blocked (a stalled browser) costs nothing per event. A client more than
+``CLIENT_QUEUE`` events behind, or behind what the ring keeps, is sent one ``missed`` marker and
+a fresh snapshot instead (coalesced state; the snapshot frame is built once per state and shared).
+A sender blocked for ``SEND_TIMEOUT`` seconds gets the client evicted: its sender is cancelled
+and its socket aborted (a clean close would wait for the unsent data of a stalled peer).
+
+This module is one piece (about 350 lines) because the feed, its clients' cursors and
+the sender loop share one invariant: what the ring holds, and which client still needs what.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import collections
+import threading
+import time
+from typing import Any, Callable
+
+from fsm.observation.encoding import dumps
+from fsm.observation.status import Status
+
+RING_SIZE = 20000          # recent events kept per machine for since=SEQ
+CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
+MAX_BATCH = 1000           # events per frame at most
+HISTORY = 5000             # events of the current run a new client is sent for its log, at most
+SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
+HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
+
+_FRAME_HEAD = b'{"type":"events","events":['
+_FRAME_TAIL = b"]}"
+
+
+class Feed:
+    """One machine's stream: its Status, the hand-off from its threads, the ring of encoded events, its clients."""
+
+    def __init__(self, name: str) -> None:
+        self.status = Status(name)
+        self.lock = threading.Lock()  # guards the Status (applied in machine threads) and the hand-off
+        self.handoff: collections.deque[tuple[int, bytes]] = collections.deque()  # machine thread -> loop
+        self.dropped = 0  # events dropped from the hand-off since the loop last drained it
+        self.queued = False  # the feed waits in the fan-out's ready queue
+        self.ring: collections.deque[tuple[int, bytes]] = collections.deque(maxlen=RING_SIZE)
+        self.loop_seq = 0  # the seq of the newest event the loop has taken (the ring's end, gaps or not)
+        self.clients: set[Client] = set()
+        self.idle: set[Client] = set()  # clients whose sender waits for the next event
+        self._snapshot: tuple[int, int, str] | None = None  # (id(status), last_seq, frame)
+
+    # In the machine's thread.
+    def observe(self, event: dict) -> bool:
+        """Apply, encode, hand over; True when the loop must be told."""
+        encoded = dumps(event)
+        with self.lock:
+            self.status.apply(event)
+            handoff = self.handoff
+            if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
+                self.dropped += len(handoff)
+                handoff.clear()
+            handoff.append((event["seq"], encoded))
+            if self.queued:
+                return False
+            self.queued = True
+            return True
+
+    # On the loop.
+    def take_handoff(self) -> None:
+        """Move what the machine threads handed over into the ring; wake idle senders."""
+        with self.lock:
+            items, self.handoff = self.handoff, collections.deque()
+            dropped, self.dropped = self.dropped, 0
+            self.queued = False
+        if not items:
+            return
+        if dropped:  # a gap: clients whose cursor falls in it are sent missed + a snapshot
+            self.ring.clear()
+        self.ring.extend(items)
+        self.loop_seq = items[-1][0]
+        if self.idle:
+            self.wake_idle()
+
+    def apply(self, event: dict) -> None:
+        """An event from another process: update the Status, keep the event (encoded once), wake idle senders."""
+        with self.lock:
+            self.status.apply(event)
+        self.ring.append((event["seq"], dumps(event)))
+        self.loop_seq = event["seq"]
+        if self.idle:
+            self.wake_idle()
+
+    def reset(self, status: Status) -> None:
+        """A new epoch (an ingesting process restarted, or sent a snapshot): clients start over."""
+        with self.lock:
+            self.status = status
+        self.ring.clear()
+        self.loop_seq = status.last_seq
+        for client in self.clients:
+            client.need_snapshot = True
+        self.wake_idle()
+
+    def wake_idle(self) -> None:
+        idle = self.idle
+        if idle:
+            for client in idle:
+                client.wake.set()
+            idle.clear()
+
+    def status_dict(self) -> dict:
+        """``Status.to_dict()``, consistent (machine threads apply events to it concurrently), with the
+        states a pending preempt still waits on."""
+        with self.lock:
+            data = self.status.to_dict()
+            data["preempt_waiting_on"] = self.status.preempt_waiting_on()
+        return data
+
+    def snapshot(self) -> tuple[int, str]:
+        """(last_seq, the snapshot frame): built once per state, shared by every client that needs it."""
+        with self.lock:
+            status = self.status
+            cached = self._snapshot
+            if cached is not None and cached[0] == id(status) and cached[1] == status.last_seq:
+                return cached[1], cached[2]
+            data = status.to_dict()
+            key = (id(status), status.last_seq)
+        frame = dumps({"type": "snapshot", "status": data, "last_seq": key[1]}).decode()
+        self._snapshot = (key[0], key[1], frame)
+        return key[1], frame
+
+    def history(self, upto: int) -> str:
+        """The current run's events up to ``upto`` (from the ring, the newest ``HISTORY`` at most), as
+        JSON ``{"complete", "events"}``; ``complete`` says whether it reaches back to the run's start."""
+        with self.lock:
+            start = self.status.run_seq
+        ring = self.ring
+        first = ring[0][0] if ring else upto + 1
+        events = [encoded for seq, encoded in ring if start <= seq <= upto]
+        complete = first <= start and len(events) <= HISTORY
+        return (b'{"complete":%s,"events":[%s]}'
+                % (b"true" if complete else b"false", b",".join(events[-HISTORY:]))).decode()
+
+    def keeps_after(self, since: int) -> bool:
+        """Whether the ring still holds every event after ``since`` (a client can resume from there)."""
+        return since <= self.status.last_seq and self.encoded_from(since + 1, 1) is not None
+
+    def encoded_from(self, seq: int, limit: int) -> list[bytes] | None:
+        """Up to ``limit`` encoded events from ``seq`` on; None when ``seq`` is no longer kept."""
+        ring = self.ring
+        if seq > self.loop_seq:
+            return []
+        if not ring:
+            return None
+        first = ring[0][0]
+        if seq < first:
+            return None
+        idx = seq - first
+        if idx >= len(ring) or ring[idx][0] != seq:  # seqs with a gap: find it the slow way
+            for idx, (s, _) in enumerate(ring):
+                if s >= seq:
+                    break
+            else:
+                return []
+        stop = min(len(ring), idx + limit)
+        return [ring[i][1] for i in range(idx, stop)]
+
+
+class Client:
+    """One websocket subscriber of one machine: a cursor into the feed's ring, and its sender's bookkeeping.
+
+    A client holds no events of its own: every event is encoded once into the feed's ring and each
+    sender reads from there at its own cursor. So an event costs the loop the same with any number of
+    clients, and nothing at all per client that is not idle (a stalled one is blocked in its send).
+    """
+
+    __slots__ = ("feed", "cursor", "need_snapshot", "wake", "send_started", "task", "abort", "evicted",
+                 "address")
+
+    def __init__(self, feed: Feed, abort: Callable[[], None] | None, address: str) -> None:
+        self.feed = feed
+        self.cursor = 0  # the seq of the next event to send
+        self.need_snapshot = False
+        self.wake = asyncio.Event()
+        self.send_started: float | None = None
+        self.task: asyncio.Task | None = None
+        self.abort = abort
+        self.evicted = False
+        self.address = address
+
+    def take_frames(self) -> list[str]:
+        """What to send next (called on the loop): events from the ring, or missed + a snapshot."""
+        feed = self.feed
+        if not self.need_snapshot:
+            last = feed.loop_seq
+            if self.cursor > last:
+                return []
+            batch = None
+            if last - self.cursor < CLIENT_QUEUE:
+                batch = feed.encoded_from(self.cursor, MAX_BATCH)
+            if batch:
+                self.cursor += len(batch)
+                if len(batch) == 1:
+                    return [(_FRAME_HEAD + batch[0] + _FRAME_TAIL).decode()]
+                return [(_FRAME_HEAD + b",".join(batch) + _FRAME_TAIL).decode()]
+            # Too far behind, or what it needs is no longer kept: coalesce into a snapshot.
+        seq, frame = feed.snapshot()
+        frames = []
+        missed = seq - self.cursor + 1 if self.cursor else 0
+        if missed > 0:
+            frames.append('{"type":"missed","count":%d}' % missed)
+        if not self.cursor:  # a new client: the snapshot also carries the current run's events so far
+            frame = frame[:-1] + ',"history":' + feed.history(seq) + "}"
+        frames.append(frame)
+        self.need_snapshot = False
+        self.cursor = seq + 1
+        return frames
+
+
+class Observer:
+    """What a local machine's reporter calls with each event, in the machine's thread: the first hop
+    of a transition on its way to the browser (the next is ``Feed.take_handoff``, on the loop)."""
+
+    __slots__ = ("feed", "fanout")
+
+    def __init__(self, feed: Feed, fanout: Fanout) -> None:
+        self.feed = feed
+        self.fanout = fanout
+
+    def __call__(self, event: dict) -> None:
+        if self.feed.observe(event):
+            self.fanout.ready(self.feed)
+
+
+class Fanout:
+    """The loop's side: takes the feeds' hand-offs into their rings, runs each client's sender, evicts stalled ones."""
+
+    def __init__(self) -> None:
+        self.loop: asyncio.AbstractEventLoop | None = None
+        self._ready: collections.deque[Feed] = collections.deque()  # feeds with a hand-off to take
+        self._scheduled = False
+        self._clients: set[Client] = set()
+        self._watchdog: asyncio.Task | None = None
+
+    def bind_loop(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Start on the loop that serves the clients (the app's lifespan)."""
+        self.loop = loop
+        self._watchdog = loop.create_task(self._watch())
+        if self._ready:
+            self._schedule()
+
+    async def close(self) -> None:
+        if self._watchdog is not None:
+            self._watchdog.cancel()
+        for client in list(self._clients):
+            self.evict(client)
+
+    # The hand-off from machine threads.
+    def ready(self, feed: Feed) -> None:
+        """In a machine's thread: ``feed`` has a hand-off for the loop to take."""
+        self._ready.append(feed)
+        if not self._scheduled:
+            self._schedule()
+
+    def _schedule(self) -> None:
+        loop = self.loop
+        if loop is None:
+            return  # drained when the loop binds
+        self._scheduled = True
+        try:
+            loop.call_soon_threadsafe(self._drain)
+        except RuntimeError:  # the loop closed: the server stopped, the machine goes on
+            self._scheduled = False
+
+    def _drain(self) -> None:
+        self._scheduled = False
+        ready = self._ready
+        while ready:
+            ready.popleft().take_handoff()
+
+    def flush(self) -> None:
+        """On the loop: take whatever machine threads handed over into the rings (before reading them)."""
+        if self._ready:
+            self._drain()
+
+    # Clients (on the loop).
+    def subscribe(self, feed: Feed, since: int | None, abort: Callable[[], None] | None,
+                  address: str = "") -> Client:
+        """A new client of ``feed``: from ``since`` + 1 when the ring still has it, else from a snapshot."""
+        self.flush()
+        client = Client(feed, abort, address)
+        if since is not None and feed.keeps_after(since):
+            client.cursor = since + 1
+        else:
+            client.need_snapshot = True
+        feed.clients.add(client)
+        self._clients.add(client)
+        client.wake.set()
+        return client
+
+    def unsubscribe(self, client: Client) -> None:
+        client.feed.clients.discard(client)
+        client.feed.idle.discard(client)
+        self._clients.discard(client)
+
+    def evict(self, client: Client) -> None:
+        if client.evicted:
+            return
+        client.evicted = True
+        self.unsubscribe(client)
+        if client.abort is not None:
+            try:
+                client.abort()
+            except Exception:
+                pass
+        if client.task is not None:
+            client.task.cancel()
+
+    async def run_client(self, client: Client, send: Callable[[str], Any]) -> None:
+        """The sender: one frame per event when idle, batches when events come faster."""
+        try:
+            while not client.evicted:
+                frames = client.take_frames()
+                if not frames:
+                    client.wake.clear()
+                    client.feed.idle.add(client)
+                    await client.wake.wait()
+                    continue
+                for frame in frames:
+                    client.send_started = time.monotonic()
+                    await send(frame)
+                    client.send_started = None
+        finally:
+            self.unsubscribe(client)
+
+    async def _watch(self) -> None:
+        while True:
+            await asyncio.sleep(min(1.0, SEND_TIMEOUT / 4))
+            now = time.monotonic()
+            for client in list(self._clients):
+                started = client.send_started
+                if started is not None and now - started > SEND_TIMEOUT:
+                    self.evict(client)

@@ -1,0 +1,62 @@
+"""What a page can do to a machine of this process: preempt, hold, set its initial state, start it,
+and publish on the in-process bus. The machine's side is server/control.py; its calls may block
+briefly on the machine's locks, so they run in a worker thread, never on the event loop."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+from fastapi import APIRouter, Body, Path
+from fastapi.concurrency import run_in_threadpool
+
+from .. import models
+from ..control import publish
+from .deps import AUTH, ERRORS, ClientAddress, Handle, HubDep
+
+router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["control"])
+
+TOPIC = Path(min_length=1, max_length=200, pattern=r"^[A-Za-z0-9_.~/-]+$", description="topic name")
+
+
+@router.post("/api/machines/{name}/preempt", status_code=202, response_model=models.SeqResponse)
+async def preempt(handle: Handle, client: ClientAddress,
+                  body: Annotated[models.PreemptRequest | None, Body()] = None) -> models.SeqResponse:
+    reason = body.reason if body is not None else None
+    return models.SeqResponse(seq=await run_in_threadpool(handle.preempt, reason, client))
+
+
+@router.post("/api/machines/{name}/hold", status_code=202, response_model=models.SeqResponse,
+             description="Let the current run finish, then start no other until the next start "
+                         "(a machine its host runs in a loop, such as the demo's episodes; 409 otherwise).")
+async def hold(handle: Handle, client: ClientAddress,
+               body: Annotated[models.PreemptRequest | None, Body()] = None) -> models.SeqResponse:
+    reason = body.reason if body is not None else None
+    return models.SeqResponse(seq=await run_in_threadpool(handle.hold, reason, client))
+
+
+@router.post("/api/machines/{name}/initial-state", response_model=models.SeqResponse)
+async def initial_state(handle: Handle, client: ClientAddress, body: models.InitialStateRequest) -> models.SeqResponse:
+    seq = await run_in_threadpool(handle.set_initial_state, body.path, list(body.states), dict(body.userdata),
+                                  client)
+    return models.SeqResponse(seq=seq)
+
+
+@router.post("/api/machines/{name}/start", status_code=202, response_model=models.SeqResponse)
+async def start(handle: Handle, client: ClientAddress,
+                body: Annotated[models.StartRequest | None, Body()] = None) -> models.SeqResponse:
+    return models.SeqResponse(seq=await run_in_threadpool(handle.start, client))
+
+
+@router.post("/api/topics/{topic}", status_code=202, response_model=models.Delivered)
+async def publish_topic(topic: Annotated[str, TOPIC], hub: HubDep, client: ClientAddress,
+                        message: Annotated[Any, Body(description="any JSON value: the message")] = None
+                        ) -> models.Delivered:
+    def do() -> int:
+        delivered = publish(topic, message)
+        for entry in hub.machines():
+            if entry.handle is not None and entry.handle.is_running():
+                entry.handle.emit_control("publish", client, "accepted",
+                                          params={"topic": topic, "delivered": delivered})
+        return delivered
+
+    return models.Delivered(delivered=await run_in_threadpool(do))

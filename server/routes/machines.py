@@ -1,0 +1,59 @@
+"""What the dashboard reads about machines: the list, a machine's structure and status, its graph."""
+
+from __future__ import annotations
+
+from typing import Annotated, Any
+
+from fastapi import APIRouter, HTTPException, Query
+from fastapi.concurrency import run_in_threadpool
+from fastapi.responses import Response
+
+from .. import graph, models
+from ..control import find_node
+from .deps import AUTH, ERRORS, HubDep, Machine
+
+router = APIRouter(dependencies=AUTH, tags=["machines"])
+
+
+@router.get("/api/machines", response_model=list[models.MachineInfo], responses=ERRORS)
+async def list_machines(hub: HubDep) -> list[dict]:
+    out = []
+    for entry in hub.machines():
+        status = entry.status
+        handle = entry.handle
+        out.append({"name": entry.name, "running": entry.running(), "outcome": status.outcome,
+                    "last_seq": status.last_seq, "root_path": status.root_path,
+                    "can_start": bool(handle is not None and handle.can_start),
+                    "can_hold": bool(handle is not None and handle.holder is not None),
+                    "held": bool(handle is not None and handle.held),
+                    "source": entry.source, "connected": entry.connected, "rejected": entry.rejected})
+    return out
+
+
+@router.get("/api/machines/{name}/structure", response_model=models.StructureNode, responses=ERRORS)
+async def structure(entry: Machine) -> Any:
+    if entry.status.structure is None:
+        raise HTTPException(404, "machine %r has no structure yet" % entry.name)
+    return entry.status.structure
+
+
+@router.get("/api/machines/{name}/status", response_model=models.MachineStatus, responses=ERRORS)
+async def status(entry: Machine) -> Any:
+    data = entry.status_dict()
+    data.pop("structure", None)
+    return data
+
+
+@router.get("/api/machines/{name}/graph.svg",
+            responses={**ERRORS, 200: {"content": {"image/svg+xml": {}}, "description": "the graph"}})
+async def graph_svg(entry: Machine, expand: Annotated[list[str] | None, Query(max_length=200)] = None) -> Response:
+    root = entry.status.structure
+    if root is None:
+        raise HTTPException(404, "machine %r has no structure yet" % entry.name)
+    key, n_states = entry.structure_info()
+    for path in expand or ():
+        node = find_node(root, path)
+        if node is None or not node.get("container"):
+            raise HTTPException(404, "no container at %r" % path)
+    svg = await run_in_threadpool(graph.render, root, key, expand, n_states)
+    return Response(svg, media_type="image/svg+xml", headers={"Cache-Control": "no-cache"})

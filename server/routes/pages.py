@@ -1,0 +1,57 @@
+"""The pages: the dashboard, the API's own documentation page, health and where the 3D view is."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+
+from fastapi import APIRouter, Request
+from fastapi.openapi.docs import get_swagger_ui_html
+from fastapi.responses import FileResponse, HTMLResponse, Response
+
+from .. import models
+from .deps import AUTH, ERRORS
+
+router = APIRouter()
+
+_PLACEHOLDER = ("<!doctype html><meta charset=utf-8><title>fsmscope</title>"
+                "<p>fsmscope server is running; the dashboard (static/index.html) is not installed. "
+                "See <a href=/docs>/docs</a>.</p>")
+
+
+def static_dir() -> str | None:
+    """Where the dashboard's files are (the ``static`` package), or None when it is not installed."""
+    spec = importlib.util.find_spec("static")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    return list(spec.submodule_search_locations)[0]
+
+
+@router.get("/", include_in_schema=False)
+async def index() -> Response:
+    """The page holds no data; it takes the token from its URL (static/token.js)."""
+    root = static_dir()
+    if root and os.path.isfile(os.path.join(root, "index.html")):
+        return FileResponse(os.path.join(root, "index.html"), headers={"Cache-Control": "no-cache"})
+    return HTMLResponse(_PLACEHOLDER)
+
+
+@router.get("/docs", include_in_schema=False)
+async def docs(request: Request) -> HTMLResponse:
+    """OpenAPI's page, with Swagger UI served from the swagger-ui-bundle package (mounted at
+    /docs-assets by the app): a robot's network reaches no CDN, so FastAPI's default page would
+    stay blank there."""
+    return get_swagger_ui_html(openapi_url=request.app.openapi_url, title=request.app.title + " API",
+                               swagger_js_url="/docs-assets/swagger-ui-bundle.js",
+                               swagger_css_url="/docs-assets/swagger-ui.css",
+                               swagger_favicon_url="/docs-assets/favicon-32x32.png")
+
+
+@router.get("/api/health", response_model=models.Health, tags=["meta"])
+async def health() -> models.Health:
+    return models.Health(ok=True)
+
+
+@router.get("/api/scene", response_model=models.Scene, dependencies=AUTH, responses=ERRORS, tags=["meta"])
+async def scene(request: Request) -> models.Scene:
+    return models.Scene(url=request.app.state.settings.scene_url)

@@ -1,0 +1,91 @@
+"""The live stream of one machine's events (docs/api.md, "Stream"), and the send path it writes through.
+
+A transition reaches the browser in three hops: the machine's ``fanout.Observer`` (machine
+thread), ``Feed.take_handoff`` (event loop), and this route's sender, ``Fanout.run_client``,
+which writes each frame with the server's own ``send``. ``KeepServerSend`` (installed by the
+app outside Starlette's wrappers) keeps that ``send`` in the scope: frames skip the per-message
+wrappers, and a stalled socket can be aborted through the protocol the ``send`` is bound to.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+from typing import Any, Callable
+
+from fastapi import APIRouter, WebSocket
+
+from ..auth import websocket_subprotocol
+from .deps import HubDep, deny_websocket, refused
+
+router = APIRouter()
+
+SERVER_SEND = "fsmscope.server_send"  # the scope key KeepServerSend fills
+
+
+class KeepServerSend:
+    """Pure ASGI: keeps each websocket's ``send``, as the server gave it, in its scope."""
+
+    def __init__(self, app: Any) -> None:
+        self.app = app
+
+    async def __call__(self, scope: dict, receive: Any, send: Any) -> None:
+        if scope["type"] == "websocket":
+            scope[SERVER_SEND] = send
+        await self.app(scope, receive, send)
+
+
+def _abort(server_send: Any) -> Callable[[], None] | None:
+    """A way to drop a stalled socket without a clean close (which would wait for unsent data)."""
+    protocol = getattr(server_send, "__self__", None)
+    transport = getattr(protocol, "transport", None)
+    if transport is None or not hasattr(transport, "abort"):
+        return None
+    return transport.abort
+
+
+@router.websocket("/api/machines/{name}/stream")
+async def stream(websocket: WebSocket, name: str, hub: HubDep) -> None:
+    if await refused(websocket):
+        return
+    since_text = websocket.query_params.get("since")
+    since = None
+    if since_text is not None:
+        try:
+            since = int(since_text)
+        except ValueError:
+            await deny_websocket(websocket, 422, "since must be an integer")
+            return
+    entry = hub.get(name)
+    if entry is None:
+        await deny_websocket(websocket, 404, "no machine named %r" % name)
+        return
+    await websocket.accept(websocket_subprotocol(websocket))
+    server_send = websocket.scope[SERVER_SEND]
+
+    async def send(frame: str) -> None:
+        await server_send({"type": "websocket.send", "text": frame})
+
+    fanout = hub.fanout
+    address = websocket.client.host if websocket.client else ""
+    client = fanout.subscribe(entry, since, _abort(server_send), address)
+    sender = asyncio.ensure_future(fanout.run_client(client, send))
+    client.task = sender
+    receiver = asyncio.ensure_future(_drain_incoming(websocket))
+    try:
+        await asyncio.wait([sender, receiver], return_when=asyncio.FIRST_COMPLETED)
+    finally:
+        for task in (sender, receiver):
+            task.cancel()
+        fanout.unsubscribe(client)
+        for task in (sender, receiver):
+            with contextlib.suppress(BaseException):
+                await task
+
+
+async def _drain_incoming(websocket: WebSocket) -> None:
+    """Client-to-server messages are ignored; returns when the client leaves."""
+    while True:
+        message = await websocket.receive()
+        if message["type"] == "websocket.disconnect":
+            return

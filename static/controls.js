@@ -1,0 +1,99 @@
+// What controls the machine shown: Preempt, Start, "Stop after this run" and "Set as initial state…",
+// each disabled (the menu item saying why) when the server would refuse it.
+
+import { api } from "./api.js";
+import { confirmPreempt, editInitialState } from "./dialogs.js";
+import { heldText } from "./loop.js";
+import { controlRefusal } from "./machines.js";
+import { notice } from "./notice.js";
+import { parentPath } from "./status.js";
+
+const $ = (id) => document.getElementById(id);
+
+export class Controls {
+  /**
+   * @param {Store} store the machine shown (store.js)
+   * @param {Machines} machines the served machines (machines.js)
+   * @param {RunNotices} notices what the notice says of its runs (notice.js)
+   * @param {() => boolean} live whether its stream is live
+   */
+  constructor(store, machines, notices, live) {
+    this.store = store;
+    this.machines = machines;
+    this.notices = notices;
+    this.live = live;
+    $("preempt-btn").addEventListener("click", () => this._preempt());
+    $("start-btn").addEventListener("click", () => this._ask("Start", api.start));
+    $("hold-btn").addEventListener("click", () => this._ask("Stop after this run", api.hold, ": then the loop waits for Start"));
+  }
+
+  /** Enable what the machine shown accepts now; show whether its loop is held. */
+  update() {
+    const entry = this.machines.current();
+    const running = this.store.status ? this.store.status.running : false;
+    const live = this.machines.online && this.live();
+    const controllable = !controlRefusal(entry);
+    $("preempt-btn").disabled = !live || !running || !controllable;
+    $("start-btn").disabled = !live || running || !controllable || !entry.can_start;
+    const hold = $("hold-btn");
+    hold.hidden = !entry?.can_hold;
+    hold.disabled = !live || !running || !controllable || entry.held;
+    const loop = $("loop-state");
+    loop.hidden = !entry?.held;
+    if (loop.textContent !== heldText(running)) loop.textContent = heldText(running);
+  }
+
+  /** The menu item "Set as initial state…" for the state at `path`. */
+  initialStateItem(path) {
+    const nodes = this.store.nodes;
+    const node = nodes.get(path);
+    const container = parentPath(path);
+    const parent = container ? nodes.get(container) : null;
+    const refusal = controlRefusal(this.machines.current());
+    const takesInitial = parent && parent.type !== "Concurrence" && parent.type !== "Iterator";
+    return {
+      label: "Set as initial state…",
+      disabled: !node || !parent || !takesInitial || Boolean(refusal),
+      title: !parent ? "the root has no parent container" : !takesInitial ? `a ${parent.type} has no initial state to choose` : refusal,
+      action: () => this._setInitial(container, node.label),
+    };
+  }
+
+  async _setInitial(container, state) {
+    const name = this.store.name;
+    const ok = await editInitialState({
+      container, state, userdata: this.store.status.containers[container]?.userdata || {},
+      submit: (value) => api.setInitialState(name, container, [state], value),
+    });
+    if (ok) this._say(name, `Initial state of ${container} set to ${state} (next run)`, "ok");
+  }
+
+  async _preempt() {
+    const name = this.store.name;
+    const answer = await confirmPreempt(name);
+    if (!answer) return;
+    this.notices.preemptSent();
+    try {
+      const ack = await api.preempt(name, answer.reason);
+      if (name === this.store.name) this.notices.preemptAccepted(ack.seq);
+    } catch (err) {
+      if (name === this.store.name) this.notices.preemptFailed(err);
+    }
+  }
+
+  /** Ask the server for `what` by `call(name)`; a notice says how it answered. */
+  async _ask(what, call, then = "") {
+    const name = this.store.name;
+    try {
+      const ack = await call(name);
+      this._say(name, `${what} accepted (event ${ack.seq})${then}`, "ok");
+    } catch (err) {
+      this._say(name, `${what} failed: ` + (err.detail || err.message), "error", true);
+    }
+  }
+
+  /** A notice about machine `name`, dropped when the page has moved to another machine meanwhile. */
+  _say(name, text, level, sticky) {
+    if (name === this.store.name) notice(text, level, sticky);
+  }
+}

@@ -1,2 +1,3 @@
 """Watching a machine: the event schema, the reporter that emits events (``attach``, global hooks),
-the reducer that rebuilds a machine's state from events (``Status``), and JSON encoding of values."""
+the walks over a machine's structure (``structure``), the reducer that rebuilds a machine's state
+from events (``Status``), and JSON encoding of values."""

@@ -86,3 +86,11 @@ def test_a_replayed_machine_offers_no_initial_state_and_says_why(replay_page):
     item = replay_page.locator("#menu button", has_text="Set as initial state")
     assert item.is_disabled()
     assert "replay" in item.get_attribute("title")
+
+
+@pytest.mark.timeout(60)
+def test_a_replayed_machine_that_finished_offers_no_start_and_no_stop_after_this_run(replay_page):
+    replay_page.wait_for_selector("#run-state:has-text('finished: done')")
+    replay_page.wait_for_selector("#badge.live")
+    assert replay_page.is_disabled("#start-btn")
+    assert replay_page.is_hidden("#hold-btn")

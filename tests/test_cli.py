@@ -5,6 +5,7 @@ import os
 import queue
 import re
 import signal
+import socket
 import subprocess
 import sys
 import threading
@@ -136,6 +137,18 @@ def test_replay_serve_of_an_empty_file_exits_2_instead_of_serving(tmp_path):
     done = cli("replay", log, "--serve", timeout=20)
     assert done.returncode == 2
     assert "fsmscope replay: %s: no events (the file is empty)" % log in done.stderr
+
+
+@pytest.mark.parametrize("command", [["serve"], ["run", os.path.join(EXAMPLES, "foo_bar.py")]],
+                         ids=["serve", "run"])
+def test_a_command_whose_port_is_taken_says_why_and_exits_1(tmp_path, command):
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        done = cli(*command, "--port", taken.getsockname()[1], cwd=tmp_path, timeout=30)
+    assert done.returncode == 1
+    assert done.stderr.startswith("fsmscope %s: " % command[0]) and "already in use" in done.stderr
+    assert "Traceback" not in done.stderr
 
 
 def test_replay_reports_a_truncated_last_line_and_replays_the_rest(foo_bar_log, tmp_path):

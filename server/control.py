@@ -25,20 +25,6 @@ class ControlError(Exception):
         self.message = message
 
 
-def find_node(root: dict | None, path: str) -> dict | None:
-    if root is None:
-        return None
-    if root["path"] == path:
-        return root
-    if not path.startswith(root["path"] + "/"):
-        return None
-    for child in root.get("children", ()):
-        found = find_node(child, path)
-        if found is not None:
-            return found
-    return None
-
-
 class MachineHandle:
     """Preempt, set the initial state of, and re-run one local machine.
 

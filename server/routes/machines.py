@@ -8,8 +8,9 @@ from fastapi import APIRouter, HTTPException, Query
 from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
+from fsm.observation.structure import node_at
+
 from .. import graph, models
-from ..control import find_node
 from .deps import AUTH, ERRORS, HubDep, Machine
 
 router = APIRouter(dependencies=AUTH, tags=["machines"])
@@ -52,7 +53,7 @@ async def graph_svg(entry: Machine, expand: Annotated[list[str] | None, Query(ma
         raise HTTPException(404, "machine %r has no structure yet" % entry.name)
     key, n_states = entry.structure_info()
     for path in expand or ():
-        node = find_node(root, path)
+        node = node_at(root, path)
         if node is None or not node.get("container"):
             raise HTTPException(404, "no container at %r" % path)
     svg = await run_in_threadpool(graph.render, root, key, expand, n_states)

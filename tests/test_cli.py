@@ -14,7 +14,7 @@ import httpx
 import pytest
 from fsm.observation.encoding import dumps
 
-from recording_support import EXAMPLES, FAST, ROOT, cli
+from recording_support import EXAMPLES, ROOT, cli
 from server.testing.polling import wait_for
 
 

@@ -182,10 +182,9 @@ class Client:
     clients, and nothing at all per client that is not idle (a stalled one is blocked in its send).
     """
 
-    __slots__ = ("feed", "cursor", "need_snapshot", "wake", "send_started", "task", "abort", "evicted",
-                 "address")
+    __slots__ = ("feed", "cursor", "need_snapshot", "wake", "send_started", "task", "abort", "evicted")
 
-    def __init__(self, feed: Feed, abort: Callable[[], None] | None, address: str) -> None:
+    def __init__(self, feed: Feed, abort: Callable[[], None] | None) -> None:
         self.feed = feed
         self.cursor = 0  # the seq of the next event to send
         self.need_snapshot = False
@@ -194,7 +193,6 @@ class Client:
         self.task: asyncio.Task | None = None
         self.abort = abort
         self.evicted = False
-        self.address = address
 
     def take_frames(self) -> list[str]:
         """What to send next (called on the loop): events from the ring, or missed + a snapshot."""
@@ -292,11 +290,10 @@ class Fanout:
             self._drain()
 
     # Clients (on the loop).
-    def subscribe(self, feed: Feed, since: int | None, abort: Callable[[], None] | None,
-                  address: str = "") -> Client:
+    def subscribe(self, feed: Feed, since: int | None, abort: Callable[[], None] | None) -> Client:
         """A new client of ``feed``: from ``since`` + 1 when the ring still has it, else from a snapshot."""
         self.flush()
-        client = Client(feed, abort, address)
+        client = Client(feed, abort)
         if since is not None and feed.keeps_after(since):
             client.cursor = since + 1
         else:

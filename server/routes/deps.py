@@ -1,4 +1,4 @@
-"""What the routes share: the hub, the machine a path names, the token check, the documented errors."""
+"""What the routes share: the hub, the machine a path names, the token checks, the documented errors."""
 
 from __future__ import annotations
 
@@ -22,7 +22,10 @@ def get_hub(connection: HTTPConnection) -> Hub:
     return connection.app.state.hub
 
 
-def get_machine(name: Annotated[str, NAME], hub: Annotated[Hub, Depends(get_hub)]) -> MachineEntry:
+HubDep = Annotated[Hub, Depends(get_hub)]
+
+
+def get_machine(name: Annotated[str, NAME], hub: HubDep) -> MachineEntry:
     """The machine the path names; 404 when there is none."""
     entry = hub.get(name)
     if entry is None:
@@ -30,7 +33,10 @@ def get_machine(name: Annotated[str, NAME], hub: Annotated[Hub, Depends(get_hub)
     return entry
 
 
-def get_handle(entry: Annotated[MachineEntry, Depends(get_machine)]) -> MachineHandle:
+Machine = Annotated[MachineEntry, Depends(get_machine)]
+
+
+def get_handle(entry: Machine) -> MachineHandle:
     """The control handle of the machine the path names; 409 when it is not in this process."""
     if entry.handle is None:
         if entry.source == "replay":
@@ -39,13 +45,14 @@ def get_handle(entry: Annotated[MachineEntry, Depends(get_machine)]) -> MachineH
     return entry.handle
 
 
+Handle = Annotated[MachineHandle, Depends(get_handle)]
+
+
 def client_address(request: Request) -> str:
+    """Who asked, for the ``client`` of the control event a request causes."""
     return request.client.host if request.client else ""
 
 
-HubDep = Annotated[Hub, Depends(get_hub)]
-Machine = Annotated[MachineEntry, Depends(get_machine)]
-Handle = Annotated[MachineHandle, Depends(get_handle)]
 ClientAddress = Annotated[str, Depends(client_address)]
 
 

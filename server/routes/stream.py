@@ -67,8 +67,7 @@ async def stream(websocket: WebSocket, name: str, hub: HubDep) -> None:
         await server_send({"type": "websocket.send", "text": frame})
 
     fanout = hub.fanout
-    address = websocket.client.host if websocket.client else ""
-    client = fanout.subscribe(entry, since, _abort(server_send), address)
+    client = fanout.subscribe(entry, since, _abort(server_send))
     sender = asyncio.ensure_future(fanout.run_client(client, send))
     client.task = sender
     receiver = asyncio.ensure_future(_drain_incoming(websocket))

@@ -139,7 +139,8 @@ export class Transcript {
     }
     if (ev.outcome === null || ev.outcome === undefined) return null; // the runtime logs failures itself
     if (type === "Concurrence") {
-      return this.serviced.has(key) ? null : info("Concurrent Outcomes: " + pyRepr(ev.outcomes || {}));
+      const serviced = ev.outcome === "preempted" && this.serviced.has(key);
+      return serviced ? null : info("Concurrent Outcomes: " + pyRepr(ev.outcomes || {}));
     }
     const last = ev.last?.length ? ev.last[0] : "None";
     const stateOutcome = "state_outcome" in ev ? ev.state_outcome : ev.outcome;

@@ -2,9 +2,10 @@
 
 Both rebuild SMACH's log lines from the same events; the Python side is checked against the
 runtime's own printed lines (tests/test_transcript.py). Here each example is recorded as
-``fsmscope run --record`` records it, plus three machines for what no example does (an Iterator,
-a Concurrence that services a preempt, two outcomes of the last state leading to one container
-outcome), and the events of each run are fed to both, in Chromium for the JavaScript.
+``fsmscope run --record`` records it, plus machines for what no example does (an Iterator, a
+Concurrence that services a preempt, with and without a 'preempted' outcome, two outcomes of the
+last state leading to one container outcome), and the events of each run are fed to both, in
+Chromium for the JavaScript.
 """
 
 from __future__ import annotations
@@ -32,20 +33,21 @@ def iterator_run(path: Path) -> None:
     record(machine(["done"], [("IT", it, {"exhausted": "done"})]), path)
 
 
-def serviced_preempt_run(path: Path) -> None:
-    """SM_ROOT: CC (two children that service a preempt) is preempted from outside and ends 'preempted'."""
-    left, right = WaitForPreempt(), WaitForPreempt()
-    cc = concurrence(["preempted", "done"], "done", [("LEFT", left), ("RIGHT", right)])
-    sm = machine(["stopped", "done"], [("CC", cc, {"preempted": "stopped", "done": "done"})])
-
-    def preempt_once_running():
-        assert left.started.wait(5) and right.started.wait(5)
-        sm.request_preempt()
-    preempter = threading.Thread(target=preempt_once_running)
-    preempter.start()
-    outcome, _ = record(sm, path)
-    preempter.join(5)
-    assert outcome == "stopped"
+def serviced_preempt_run(cc_outcomes: list[str]):
+    """SM_ROOT: CC (two children that service a preempt) is preempted from outside; with 'preempted'
+    among its outcomes it ends so, without it goes on to its default outcome 'done'."""
+    def run(path: Path) -> None:
+        left, right = WaitForPreempt(), WaitForPreempt()
+        cc = concurrence(cc_outcomes, "done", [("LEFT", left), ("RIGHT", right)])
+        transitions = {"preempted": "stopped", "done": "done"}
+        sm = machine(["stopped", "done"], [("CC", cc, {o: transitions[o] for o in cc_outcomes})])
+        preempter = threading.Thread(target=lambda: left.started.wait(5) and right.started.wait(5)
+                                     and sm.request_preempt())
+        preempter.start()
+        outcome, _ = record(sm, path)
+        preempter.join(5)
+        assert outcome == ("stopped" if "preempted" in cc_outcomes else "done")
+    return run
 
 
 def two_outcomes_to_one_run(path: Path) -> None:
@@ -61,8 +63,9 @@ def example_run(name: str):
 
 
 RUNS = {**{p.stem: example_run(p.stem) for p in sorted(Path(EXAMPLES).glob("*.py"))},
-        "iterator": iterator_run, "concurrence_serviced_preempt": serviced_preempt_run,
-        "two_outcomes_to_one": two_outcomes_to_one_run}
+        "iterator": iterator_run, "two_outcomes_to_one": two_outcomes_to_one_run,
+        "concurrence_serviced_preempt": serviced_preempt_run(["preempted", "done"]),
+        "concurrence_serviced_preempt_without_preempted_outcome": serviced_preempt_run(["done"])}
 
 
 @pytest.fixture(scope="module")

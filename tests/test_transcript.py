@@ -1,12 +1,14 @@
 """fsm.logfiles.transcript: the replayed lines are the lines SMACH printed live, word for word."""
 
+import threading
+
 import fsm
 import pytest
 from fsm.logfiles.log_reader import read_events
 from fsm.logfiles.transcript import Transcript, messages, transcript
 
 from recording_support import load_example, record
-from smach_support import Out, machine
+from smach_support import Out, WaitForPreempt, concurrence, machine
 
 
 def _replayed(path):
@@ -36,6 +38,20 @@ def test_nested_concurrence_replays_the_live_log_lines_word_for_word(tmp_path, l
     # "Action long_task terminated ..." at debug level) carry no machine: they are not events.
     assert _replayed(path) == [line for line in logs.all if line[0] != "debug"]
     assert "Concurrent Outcomes: {'ACTION': 'preempted', 'MONITOR': 'invalid'}" in logs.info
+
+
+def test_a_concurrence_without_a_preempted_outcome_that_services_a_preempt_replays_its_outcomes_line(tmp_path, logs):
+    left, right = WaitForPreempt(), WaitForPreempt()
+    sm = machine(["done"], [("CC", concurrence(["done"], "done", [("LEFT", left), ("RIGHT", right)]), {"done": "done"})])
+    preempter = threading.Thread(target=lambda: left.started.wait(5) and right.started.wait(5) and sm.request_preempt())
+    preempter.start()
+    path = tmp_path / "run.jsonl"
+    logs.all.clear()  # construction lines come before any event
+    outcome, _ = record(sm, path)
+    preempter.join(5)
+    assert outcome == "done"
+    assert _replayed(path) == logs.all
+    assert "Concurrent Outcomes: {'LEFT': 'preempted', 'RIGHT': 'preempted'}" in logs.info
 
 
 def test_termination_line_names_the_state_outcome_behind_a_renamed_container_outcome(tmp_path, logs):

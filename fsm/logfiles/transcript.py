@@ -93,8 +93,8 @@ class Transcript:
         if outcome is None:
             return []  # failures are logged by the runtime itself (log events)
         if ctype == "Concurrence":
-            if (event["machine"], event["path"]) in self._serviced:
-                return []
+            if outcome == "preempted" and (event["machine"], event["path"]) in self._serviced:
+                return []  # without a 'preempted' outcome it goes on to its outcome map, and prints it
             return [("info", "Concurrent Outcomes: " + str(event.get("outcomes") or {}))]
         if ctype == "Iterator":
             return []

@@ -1,6 +1,7 @@
 // Which containers the graph draws open: the depth selector (auto, 1..N, custom) and a double-click
 // that opens or closes one container.
 
+import { h } from "./panels.js";
 import { containers, parentPath } from "./status.js";
 
 export class Depth {
@@ -35,17 +36,9 @@ export class Depth {
     if (this.expand) this.expand = new Set([...this.expand].filter((p) => nodes.has(p)));
     const max = [...containers(this.store.status.structure)].reduce((m, n) => Math.max(m, this._depthOf(n.path) + 1), 1);
     const current = this.select.value;
-    const options = [["auto", "auto"]];
-    for (let d = 1; d <= max; d++) options.push([String(d), String(d)]);
-    options.push(["custom", "custom"]);
-    this.select.replaceChildren(...options.map(([value, text]) => {
-      const o = document.createElement("option");
-      o.value = value;
-      o.textContent = text;
-      if (value === "custom") o.hidden = true;
-      return o;
-    }));
-    this.select.value = options.some(([v]) => v === current) ? current : "auto";
+    const values = ["auto", ...Array.from({ length: max }, (_, i) => String(i + 1)), "custom"];
+    this.select.replaceChildren(...values.map((value) => h("option", { value, text: value, hidden: value === "custom" })));
+    this.select.value = values.includes(current) ? current : "auto";
   }
 
   /** Open the container at `path` or close it (`isCluster`: it is drawn open). */

@@ -4,6 +4,7 @@
 import { api, ApiError } from "./api.js";
 import { holdChange } from "./loop.js";
 import { banner } from "./notice.js";
+import { h } from "./panels.js";
 import { CONTROLLABLE_SOURCES, SOURCES } from "./schema.js";
 
 const POLL_MS = 2000;
@@ -131,12 +132,7 @@ export class Machines {
       return [m.name, `${m.name}  (${text}${m.source === SOURCES.ingest ? ", remote" : ""})`];
     });
     if (labels.map(([v, t]) => v + "\u0000" + t).join("\u0001") === have) return;
-    this.picker.replaceChildren(...labels.map(([value, text]) => {
-      const o = document.createElement("option");
-      o.value = value;
-      o.textContent = text;
-      return o;
-    }));
+    this.picker.replaceChildren(...labels.map(([value, text]) => h("option", { value, text })));
     if (name) this.picker.value = name;
   }
 }

@@ -1,6 +1,9 @@
 // An event as the SMACH log line it stands for (docs/events.md: the runtime's start,
-// transition, termination and Concurrence lines are rebuilt from events, word for word).
+// transition, termination and Concurrence lines are rebuilt from events, word for word), in
+// the words of fsm/logfiles/transcript.py; an event that stands for none is described instead.
 // Returns plain text; the caller puts it in the page with textContent.
+
+import { allNodes } from "./status.js";
 
 /** Python's repr() of a str. */
 export function pyStr(s) {
@@ -59,11 +62,6 @@ function pyS(value) {
   return typeof value === "string" ? value : pyRepr(value);
 }
 
-function* walk(node) {
-  yield node;
-  for (const child of node.children || []) yield* walk(child);
-}
-
 /** The container class behind an event's path, from its structure node or, without one, guessed
  * from the event (fsm/logfiles/structure_index.py's container_type: the same rules). */
 export function containerType(ev, node) {
@@ -111,7 +109,7 @@ export class Transcript {
   _index(ev) {
     const root = ev.kind === "structure" ? ev.root : ev.kind === "snapshot" ? ev.status?.structure : null;
     if (!root) return;
-    for (const node of walk(root)) if (node.container) this.own.set(ev.machine + "\n" + node.path, node);
+    for (const node of allNodes(root)) if (node.container) this.own.set(ev.machine + "\n" + node.path, node);
   }
 
   _line(ev) {
@@ -161,12 +159,8 @@ function controlLine(ev) {
 /** An event that stands for no SMACH line, described for the event log. */
 function description(ev) {
   switch (ev.kind) {
-    case "structure": {
-      let n = 0;
-      const count = (nd) => { n += 1; (nd.children || []).forEach(count); };
-      if (ev.root) count(ev.root);
-      return { level: "debug", text: `Structure of ${ev.path}: ${n} states` };
-    }
+    case "structure":
+      return { level: "debug", text: `Structure of ${ev.path}: ${ev.root ? [...allNodes(ev.root)].length : 0} states` };
     case "terminate":
       if (ev.outcome === null || ev.outcome === undefined) {
         return { level: "error", text: `Container ${ev.path} ended without an outcome` + (ev.error ? `: ${ev.error}` : ".") };

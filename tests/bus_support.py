@@ -1,25 +1,9 @@
-"""Fixtures and helpers shared by the bus, actionlib and smach_ros-state tests."""
+"""Helpers shared by the bus, actionlib and smach_ros-state tests."""
 
 import time
 
-import pytest
 from fsm.ros.actionlib import SimpleActionServer
 from fsm.ros.bus import Bus
-
-
-@pytest.fixture
-def bus() -> Bus:
-    """A private bus, so tests never see each other's topics, services or servers."""
-    return Bus()
-
-
-@pytest.fixture
-def servers():
-    """Action servers made by a test (through ``serve``), shut down after it."""
-    made: list[SimpleActionServer] = []
-    yield made
-    for server in made:
-        server.shutdown(timeout=1.0)
 
 
 def serve(bus: Bus, servers: list, execute_cb, name: str = "act", **kwargs) -> SimpleActionServer:

@@ -1,5 +1,5 @@
 """Shared fixtures: captured log lines, the runtime's globals restored after every test, a live
-server, and Debian's Chromium for the browser tests."""
+server, a private bus and its action servers, and Debian's Chromium for the browser tests."""
 
 import os
 import shutil
@@ -8,6 +8,8 @@ import fsm
 import fsm.core.log
 import pytest
 from fsm.core.container import Container
+from fsm.ros.actionlib import SimpleActionServer
+from fsm.ros.bus import Bus
 
 
 class Logs:
@@ -88,3 +90,18 @@ def browser():
         chromium = launch_chromium(pw)
         yield chromium
         chromium.close()
+
+
+@pytest.fixture
+def bus() -> Bus:
+    """A private bus, so tests never see each other's topics, services or servers."""
+    return Bus()
+
+
+@pytest.fixture
+def servers():
+    """Action servers made by a test (through ``serve``), shut down after it."""
+    made: list[SimpleActionServer] = []
+    yield made
+    for server in made:
+        server.shutdown(timeout=1.0)

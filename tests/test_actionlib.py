@@ -5,7 +5,7 @@ import threading
 import pytest
 
 from fsm.ros.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
-from bus_support import bus, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from bus_support import serve, until_preempted
 from server.testing.polling import wait_for
 
 

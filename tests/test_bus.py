@@ -5,7 +5,6 @@ import time
 
 import pytest
 
-from bus_support import bus  # noqa: F401 (fixture)
 from fsm.ros.bus import ServiceException, default_bus, get_bus
 
 

@@ -4,7 +4,6 @@ import time
 
 import fsm as smach
 
-from bus_support import bus  # noqa: F401 (fixture)
 from server.testing.polling import wait_for
 from fsm.ros.monitor_state import MonitorState
 from smach_support import Background, machine

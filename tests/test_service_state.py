@@ -7,7 +7,6 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus  # noqa: F401 (fixture)
 from server.testing.polling import wait_for
 from fsm.ros.bus import default_bus
 from fsm.ros.service_state import ServiceState

@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from bus_support import bus, serve, servers, until_preempted  # noqa: F401 (fixtures)
+from bus_support import serve, until_preempted
 from server.testing.polling import wait_for
 from fsm.ros.actionlib import GoalStatus
 from fsm.ros.simple_action_state import SimpleActionState

@@ -53,11 +53,23 @@ export const stateId = (path) => "%(s)s" + idText(path);
 export const containerId = (path) => "%(c)s" + idText(path);
 export const outcomeId = (path, outcome) => `%(o)s${idText(path)}:${idText(outcome)}`;
 export const edgeId = (path, from, outcome) => `%(e)s${idText(path)}:${idText(from)}:${idText(outcome)}`;
+
+// Which of SMACH's containers a structure node is: its type when it is one of these, else (a
+// user's subclass) the kind whose own field it carries, else a state machine.
+const CONTAINER_TYPES = Object.freeze(%(container_types)s);
+const KIND_FIELDS = Object.freeze(%(kind_fields)s);
+
+export function containerKind(node) {
+  const type = node.type ?? "StateMachine";
+  if (CONTAINER_TYPES.includes(type)) return type;
+  return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
+}
 """ % {"version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
        "sources": json.dumps({s: s for s in schema.SOURCES}), "controllable": json.dumps(list(schema.CONTROLLABLE_SOURCES)),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
-       "e": schema.ID_PREFIXES["edge"]}
+       "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),
+       "kind_fields": json.dumps([list(pair) for pair in schema.KIND_FIELDS])}
 
 
 def _table(fields: tuple[schema.Field, ...]) -> str:

@@ -6,6 +6,7 @@ import { confirmPreempt, editInitialState } from "./dialogs.js";
 import { heldText } from "./loop.js";
 import { controlRefusal } from "./machines.js";
 import { notice } from "./notice.js";
+import { containerKind } from "./schema.js";
 import { parentPath } from "./status.js";
 
 const $ = (id) => document.getElementById(id);
@@ -50,11 +51,12 @@ export class Controls {
     const container = parentPath(path);
     const parent = container ? nodes.get(container) : null;
     const refusal = controlRefusal(this.machines.current());
-    const takesInitial = parent && parent.type !== "Concurrence" && parent.type !== "Iterator";
+    const kind = parent ? containerKind(parent) : null;
+    const takesInitial = kind === "StateMachine" || kind === "Sequence";
     return {
       label: "Set as initial state…",
       disabled: !node || !parent || !takesInitial || Boolean(refusal),
-      title: !parent ? "the root has no parent container" : !takesInitial ? `a ${parent.type} has no initial state to choose` : refusal,
+      title: !parent ? "the root has no parent container" : !takesInitial ? `a ${kind} has no initial state to choose` : refusal,
       action: () => this._setInitial(container, node.label),
     };
   }

@@ -28,3 +28,14 @@ export const stateId = (path) => "s:" + idText(path);
 export const containerId = (path) => "c:" + idText(path);
 export const outcomeId = (path, outcome) => `o:${idText(path)}:${idText(outcome)}`;
 export const edgeId = (path, from, outcome) => `e:${idText(path)}:${idText(from)}:${idText(outcome)}`;
+
+// Which of SMACH's containers a structure node is: its type when it is one of these, else (a
+// user's subclass) the kind whose own field it carries, else a state machine.
+const CONTAINER_TYPES = Object.freeze(["StateMachine", "Sequence", "Concurrence", "Iterator"]);
+const KIND_FIELDS = Object.freeze([["outcome_map", "Concurrence"], ["exhausted_outcome", "Iterator"]]);
+
+export function containerKind(node) {
+  const type = node.type ?? "StateMachine";
+  if (CONTAINER_TYPES.includes(type)) return type;
+  return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
+}

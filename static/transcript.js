@@ -3,6 +3,7 @@
 // the words of fsm/logfiles/transcript.py; an event that stands for none is described instead.
 // Returns plain text; the caller puts it in the page with textContent.
 
+import { containerKind } from "./schema.js";
 import { allNodes } from "./status.js";
 
 /** Python's repr() of a str. */
@@ -55,7 +56,6 @@ export function valueText(value, max = 200) {
 }
 
 const SERVICED_PREEMPT = "Concurrence serviced preempt.";
-const STATE_MACHINE_TYPES = ["StateMachine", "Sequence"];
 
 /** Python's str() of a JSON value: what SMACH's '%s' writes. */
 function pyS(value) {
@@ -65,13 +65,7 @@ function pyS(value) {
 /** The container class behind an event's path, from its structure node or, without one, guessed
  * from the event (fsm/logfiles/structure_index.py's container_type: the same rules). */
 export function containerType(ev, node) {
-  if (node) {
-    const type = node.type ?? "StateMachine";
-    if (STATE_MACHINE_TYPES.includes(type) || type === "Concurrence" || type === "Iterator") return type;
-    if ("outcome_map" in node) return "Concurrence"; // subclasses keep their parent's fields
-    if ("exhausted_outcome" in node) return "Iterator";
-    return "StateMachine";
-  }
+  if (node) return containerKind(node);
   if (ev.kind === "transition" && (ev.to === null || ev.to === undefined)) return "Concurrence";
   if (ev.kind === "terminate" && "outcomes" in ev) return "Concurrence";
   if (ev.kind === "transition" && ev.from === ev.to) return "Iterator";

@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 
 import fsm
-from fsm.observation import structure
+from fsm.observation import schema, structure
 
 
 def leaf() -> fsm.CBState:
@@ -110,8 +110,8 @@ def test_node_at_is_none_for_a_path_not_in_the_tree(tree):
 
 
 def test_container_kind_is_the_type_of_smachs_own_containers(tree):
-    assert structure.container_kind(tree) == "StateMachine"
-    assert structure.container_kind(structure.node_at(tree, "/SM_ROOT/PAR")) == "Concurrence"
+    assert schema.container_kind(tree) == "StateMachine"
+    assert schema.container_kind(structure.node_at(tree, "/SM_ROOT/PAR")) == "Concurrence"
 
 
 def test_container_kind_of_a_concurrence_subclass_comes_from_its_outcome_map():
@@ -120,7 +120,7 @@ def test_container_kind_of_a_concurrence_subclass_comes_from_its_outcome_map():
         Parallel.add("A", leaf())
     node = fsm.attach(par).structure()
     assert node["type"] == "Parallel"
-    assert structure.container_kind(node) == "Concurrence"
+    assert schema.container_kind(node) == "Concurrence"
 
 
 def test_container_kind_of_an_iterator_subclass_comes_from_its_exhausted_outcome():
@@ -130,7 +130,7 @@ def test_container_kind_of_an_iterator_subclass_comes_from_its_exhausted_outcome
     loop = Loop(outcomes=["ok"], input_keys=[], output_keys=[], it=[])
     with loop:
         Loop.set_contained_state("BODY", leaf(), loop_outcomes=["ok"])
-    assert structure.container_kind(fsm.attach(loop).structure()) == "Iterator"
+    assert schema.container_kind(fsm.attach(loop).structure()) == "Iterator"
 
 
 def test_container_kind_of_any_other_container_is_statemachine():
@@ -140,4 +140,4 @@ def test_container_kind_of_any_other_container_is_statemachine():
     plan = Plan(outcomes=["ok"])
     with plan:
         Plan.add("STEP", leaf())
-    assert structure.container_kind(fsm.attach(plan).structure()) == "StateMachine"
+    assert schema.container_kind(fsm.attach(plan).structure()) == "StateMachine"

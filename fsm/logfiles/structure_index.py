@@ -6,7 +6,8 @@ is (a StateMachine prints different lines from a Concurrence).
 
 from __future__ import annotations
 
-from ..observation.structure import container_kind, containers
+from ..observation.schema import container_kind
+from ..observation.structure import containers
 
 
 class StructureIndex:

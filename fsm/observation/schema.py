@@ -31,6 +31,19 @@ MAX_VALUE_DEPTH = 32           # nesting of a JSON value (userdata is cut at 16 
 SOURCES = ("local", "ingest", "replay")
 CONTROLLABLE_SOURCES = ("local",)
 
+# Which of SMACH's containers a structure node is: its ``type`` when it is one of these, else (a
+# user's subclass) the kind whose own field it carries, else a state machine.
+CONTAINER_TYPES = ("StateMachine", "Sequence", "Concurrence", "Iterator")
+KIND_FIELDS = (("outcome_map", "Concurrence"), ("exhausted_outcome", "Iterator"))
+
+
+def container_kind(node: dict) -> str:
+    """The SMACH container a structure node is, for readers that treat each kind differently."""
+    kind = node.get("type", "StateMachine")
+    if kind in CONTAINER_TYPES:
+        return kind
+    return next((kind for field, kind in KIND_FIELDS if field in node), "StateMachine")
+
 Problem = Callable[[Any], "str | None"]  # a type check: None when the value fits, else what is wrong
 
 

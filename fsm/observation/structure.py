@@ -42,9 +42,6 @@ def is_concurrence(container: Any) -> bool:
 
 # The ``structure`` event's tree: nodes with label, path, container and, for a container, children.
 
-STATE_MACHINE_TYPES = ("StateMachine", "Sequence")
-
-
 def walk(root: dict, descend: Callable[[dict], bool] | None = None) -> Iterator[tuple[dict, int]]:
     """Every node with its depth (the root's is 0), parents first and children in their order.
 
@@ -78,16 +75,3 @@ def node_at(root: dict | None, path: str) -> dict | None:
         if node["path"] == path:
             return node
     return None
-
-
-def container_kind(node: dict) -> str:
-    """Which of SMACH's containers a container node is: its type, or for a subclass of one, the
-    fields it inherits (a Concurrence's ``outcome_map``, an Iterator's ``exhausted_outcome``)."""
-    kind = node.get("type", "StateMachine")
-    if kind in STATE_MACHINE_TYPES or kind in ("Concurrence", "Iterator"):
-        return kind
-    if "outcome_map" in node:
-        return "Concurrence"
-    if "exhausted_outcome" in node:
-        return "Iterator"
-    return "StateMachine"

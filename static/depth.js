@@ -1,7 +1,7 @@
 // Which containers the graph draws open: the depth selector (auto, 1..N, custom) and a double-click
 // that opens or closes one container.
 
-import { h } from "./panels.js";
+import { h } from "./dom.js";
 import { containers, parentPath } from "./status.js";
 
 export class Depth {

@@ -4,7 +4,7 @@
 import { api, ApiError } from "./api.js";
 import { holdChange } from "./loop.js";
 import { banner } from "./notice.js";
-import { h } from "./panels.js";
+import { h } from "./dom.js";
 import { CONTROLLABLE_SOURCES, SOURCES } from "./schema.js";
 
 const POLL_MS = 2000;

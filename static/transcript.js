@@ -179,14 +179,3 @@ function description(ev) {
   }
   return { level: "debug", text: `${ev.kind} ${ev.path}` };
 }
-
-/**
- * An event log row's text, from the event alone: a Concurrence's terminate after a serviced
- * preempt still reads "Concurrent Outcomes" here (Transcript#row, fed every event, knows better).
- * @param {object} ev an event
- * @param {(path: string) => object|undefined} nodeOf the structure node at a path
- * @returns {{level: string, text: string}}
- */
-export function transcript(ev, nodeOf = () => undefined) {
-  return new Transcript(nodeOf).row(ev);
-}

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import threading
+
 import fsm
 import pytest
 from browser_support import filter_log, watch
 from server.http_server import ServerThread
+from smach_support import WaitForPreempt, concurrence, machine
 
 
 def pick_and_lift():
@@ -97,3 +100,27 @@ def test_the_count_says_shown_of_total_events(logged):
     total = len(rows_shown(logged))
     filter_log(logged, "LIFT")
     assert logged.text_content("#log-count") == "%d / %d events" % (len(rows_shown(logged)), total)
+
+
+def test_a_concurrence_that_serviced_a_preempt_shows_no_concurrent_outcomes_line(browser):  # noqa: F811
+    """SMACH prints no "Concurrent Outcomes" when its children serviced a preempt; nor does the log."""
+    left, right = WaitForPreempt(), WaitForPreempt()
+    sm = machine(["stopped"], [("CC", concurrence(["preempted"], "preempted", [("LEFT", left), ("RIGHT", right)]),
+                                {"preempted": "stopped"})])
+    srv = ServerThread().start()
+    srv.hub.add_local(sm, name="stop")
+    runner = threading.Thread(target=sm.execute)
+    try:
+        page = watch(browser, srv, "stop")
+        runner.start()
+        assert left.started.wait(5) and right.started.wait(5)
+        sm.request_preempt()
+        page.wait_for_selector("#run-state:has-text('finished: stopped')")
+        page.wait_for_selector("#log .log-row.kind-terminate[data-select='/SM_ROOT']")
+        rows = rows_shown(page)
+        assert "log: Concurrence serviced preempt." in rows
+        assert not [row for row in rows if "Concurrent Outcomes" in row], rows
+        assert not page.errors
+    finally:
+        runner.join(10)
+        srv.stop()

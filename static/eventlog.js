@@ -1,0 +1,193 @@
+// The event log: every event as SMACH's line (transcript.js), filtered by kind and text.
+// Every name, value and message goes in as text (createElement + textContent), never as HTML.
+
+import { h } from "./dom.js";
+import { KINDS } from "./schema.js";
+import { Transcript } from "./transcript.js";
+
+const MAX_EVENTS = 5000;
+const MAX_ROWS = 800;
+const MAX_ROWS_PER_FRAME = 120; // under a flood only the newest rows of each frame are drawn
+
+function selectionOf(ev) {
+  const path = ev.path;
+  if (ev.kind === "transition") return path + "/" + (ev.to ?? ev.from);
+  if (ev.kind === "start" && ev.active?.length === 1) return path + "/" + ev.active[0];
+  if (ev.kind === "error" && ev.state) return path + "/" + ev.state;
+  return path;
+}
+
+function clock(t) {
+  if (typeof t !== "number") return "";
+  const d = new Date(t * 1000);
+  const pad = (n, w = 2) => String(n).padStart(w, "0");
+  return `${pad(d.getHours())}:${pad(d.getMinutes())}:${pad(d.getSeconds())}.${pad(d.getMilliseconds(), 3)}`;
+}
+
+/** The words of an event the text filter searches besides its transcript line: the states and outcomes it names. */
+function searchedWords(ev) {
+  const words = [ev.kind, ev.path, ev.from, ev.to, ev.state, ev.outcome, ev.state_outcome,
+    ...[].concat(ev.active ?? [], ev.last ?? []), ...Object.entries(ev.outcomes ?? {}).flat()];
+  return words.filter((w) => typeof w === "string");
+}
+
+/** The kinds the log shows: a checkbox per kind in a <details> popover, closed by Escape or a click elsewhere. */
+class KindFilter {
+  constructor(details, changed) {
+    this.summary = details.querySelector("summary");
+    this.boxes = KINDS.map((kind) => h("input", { type: "checkbox", value: kind, checked: true }));
+    details.querySelector(".kinds-actions").before(...this.boxes.map((box) => h("label", {}, box, " " + box.value)));
+    this._read();
+    const update = () => {
+      this._read();
+      changed();
+    };
+    details.addEventListener("change", update);
+    details.addEventListener("click", (e) => {
+      const button = e.target.closest("button[data-check]");
+      if (!button) return;
+      for (const box of this.boxes) box.checked = button.dataset.check === "all";
+      update();
+    });
+    details.addEventListener("keydown", (e) => {
+      if (e.key !== "Escape" || !details.open) return;
+      details.open = false;
+      this.summary.focus();
+    });
+    document.addEventListener("click", (e) => {
+      if (!details.contains(e.target)) details.open = false;
+    });
+  }
+
+  _read() {
+    this.hidden = new Set(this.boxes.filter((b) => !b.checked).map((b) => b.value)); // the kinds not shown
+    const shown = this.boxes.length - this.hidden.size;
+    this.summary.textContent = !this.hidden.size ? "all kinds" : shown ? `${shown} of ${this.boxes.length} kinds` : "no kinds";
+  }
+}
+
+/** The event log, filtered by kinds and by text; clicking a row selects the state it is about. */
+export class EventLog {
+  constructor(host, controls, handlers) {
+    this.host = host;
+    // {kinds: <details> of checkboxes, text: input, count: element, clear: button, partial: the note on a history cut short}
+    this.controls = controls;
+    this.handlers = handlers;
+    this.events = [];
+    this.shown = 0; // how many of this.events pass the filters
+    this.pending = []; // events not drawn yet
+    this.described = new WeakMap(); // event -> {line, text}: its transcript line and the text the filter searches
+    this.needle = ""; // the text filter, lower case
+    this.stick = true; // follow the newest row (false once the user scrolls up)
+    host.addEventListener("scroll", () => {
+      this.stick = host.scrollHeight - host.scrollTop - host.clientHeight < 24;
+    }, { passive: true });
+    this.nodeOf = () => undefined;
+    this.transcript = new Transcript((path) => this.nodeOf(path)); // fed every event in order
+    this.selectedRow = null;
+    this.kinds = new KindFilter(controls.kinds, () => this.redraw());
+    controls.text.addEventListener("input", () => this.redraw());
+    controls.clear.addEventListener("click", () => this.reset());
+    host.addEventListener("click", (e) => {
+      const row = e.target.closest(".log-row");
+      if (!row) return;
+      this.selectedRow?.classList.remove("selected");
+      row.classList.add("selected");
+      this.selectedRow = row;
+      this.handlers.select(row.dataset.select);
+    });
+  }
+
+  reset() {
+    this.events = [];
+    this.transcript = new Transcript((path) => this.nodeOf(path));
+    this.controls.partial.hidden = true;
+    this.redraw();
+  }
+
+  /** A new connection's history: the current run's events up to its snapshot; `complete` false when
+   * the server no longer keeps the run's earliest events. */
+  history({ complete, events }) {
+    this.add(events);
+    this.redraw(); // all its rows at once, not only the newest of one frame
+    const note = this.controls.partial;
+    note.hidden = complete;
+    if (!complete) {
+      const from = events.length ? ` (the log starts at event ${events[0].seq})` : "";
+      note.textContent = `Earlier events of this run are not kept by the server${from}.`;
+    }
+  }
+
+  /** An event's transcript line and the text the filter searches, worked out as it arrives: a line
+   * can depend on the events before it (no "Concurrent Outcomes" after a serviced preempt). */
+  _describe(ev) {
+    let d = this.described.get(ev);
+    if (!d) {
+      const line = this.transcript.row(ev);
+      d = { line, text: [...searchedWords(ev), line.text].join("\n").toLowerCase() };
+      this.described.set(ev, d);
+    }
+    return d;
+  }
+
+  _matches(ev) {
+    return !this.kinds.hidden.has(ev.kind) && (!this.needle || this._describe(ev).text.includes(this.needle));
+  }
+
+  _row(ev) {
+    const line = this._describe(ev).line;
+    return h("div", { class: `log-row kind-${ev.kind} level-${line.level}`, "data-select": selectionOf(ev), "data-seq": String(ev.seq) },
+      h("span", { class: "seq", text: String(ev.seq) }),
+      h("span", { class: "time", text: clock(ev.t) }),
+      h("span", { class: "kind", text: ev.kind }),
+      h("span", { class: "path", title: ev.path }, h("bdi", { text: ev.path })),
+      h("span", { class: "msg", text: line.text, title: ev.kind === "error" && ev.traceback ? ev.traceback : line.text }));
+  }
+
+  /** Keep events; their rows are drawn by the next flush() (once per animation frame, however fast they come). */
+  add(events) {
+    for (const ev of events) {
+      this._describe(ev);
+      this.events.push(ev);
+      if (this._matches(ev)) this.shown += 1;
+    }
+    const dropped = this.events.length > MAX_EVENTS ? this.events.splice(0, this.events.length - MAX_EVENTS) : [];
+    for (const ev of dropped) if (this._matches(ev)) this.shown -= 1;
+    for (const ev of events) this.pending.push(ev);
+    if (this.pending.length > 4 * MAX_ROWS_PER_FRAME) this.pending.splice(0, this.pending.length - MAX_ROWS_PER_FRAME);
+  }
+
+  flush() {
+    if (!this.pending.length) return;
+    const events = this.pending;
+    this.pending = [];
+    const stick = this.stick;
+    const fresh = events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS_PER_FRAME).map((ev) => this._row(ev));
+    if (fresh.length) {
+      this.host.querySelector(".empty")?.remove();
+      this.host.append(...fresh);
+      const extra = this.host.childElementCount - MAX_ROWS;
+      for (let i = 0; i < extra; i++) this.host.firstElementChild.remove();
+    }
+    this._count();
+    if (stick) this.host.scrollTop = this.host.scrollHeight;
+  }
+
+  /** Draw again from the kept events (the filters or the events changed). */
+  redraw() {
+    this.pending = [];
+    this.needle = this.controls.text.value.trim().toLowerCase();
+    const matching = this.events.filter((ev) => this._matches(ev));
+    this.shown = matching.length;
+    const rows = matching.slice(-MAX_ROWS).map((ev) => this._row(ev));
+    this.host.replaceChildren(...(rows.length ? rows : [h("p", { class: "empty", text: "No events." })]));
+    this.selectedRow = null;
+    this._count();
+    this.stick = true;
+    this.host.scrollTop = this.host.scrollHeight;
+  }
+
+  _count() {
+    this.controls.count.textContent = `${this.shown} / ${this.events.length} events`;
+  }
+}

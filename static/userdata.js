@@ -1,0 +1,75 @@
+// The side panel's userdata of one container.
+// Every name, value and message goes in as text (createElement + textContent), never as HTML.
+
+import { h } from "./dom.js";
+import { valueText } from "./transcript.js";
+
+/** One container's userdata, with the keys written by the last transition highlighted. */
+export class UserdataPanel {
+  constructor(host, picker, handlers) {
+    this.host = host;
+    this.picker = picker;
+    this.handlers = handlers;
+    this.path = null;
+    this.expanded = new Set();
+    this.rendered = null; // [path, userdata object, changed set] last drawn
+    picker.addEventListener("change", () => this.handlers.pick(picker.value));
+    host.addEventListener("click", (e) => {
+      const row = e.target.closest(".ud-row");
+      if (!row) return;
+      const key = row.dataset.key;
+      if (this.expanded.has(key)) this.expanded.delete(key);
+      else this.expanded.add(key);
+      this.rendered = null;
+      this.handlers.redraw();
+    });
+  }
+
+  setContainers(nodes) {
+    const options = nodes.map((n) => h("option", { value: n.path, text: n.path }));
+    this.picker.replaceChildren(...options);
+    if (this.path) this.picker.value = this.path;
+  }
+
+  show(path) {
+    if (path === this.path) return;
+    this.path = path;
+    this.expanded.clear();
+    this.rendered = null;
+    if (path) this.picker.value = path;
+  }
+
+  update(status, node, changed) {
+    const entry = this.path ? status.containers[this.path] : null;
+    const ud = entry ? entry.userdata : null;
+    const r = this.rendered;
+    if (r && r[0] === this.path && r[1] === JSON.stringify(ud) && r[2] === changed && r[3] === entry?.running) return;
+    this.rendered = [this.path, JSON.stringify(ud), changed, entry?.running];
+    if (!entry) {
+      this.host.replaceChildren(h("p", { class: "empty", text: this.path ? "No data for this container yet." : "Select a container." }));
+      return;
+    }
+    const info = h("div", { class: "ud-info" });
+    if (node) {
+      info.append(h("span", { class: "type", text: node.type }));
+      if (node.input_keys?.length) info.append(h("span", { class: "keys", text: "in: " + node.input_keys.join(", ") }));
+      if (node.output_keys?.length) info.append(h("span", { class: "keys", text: "out: " + node.output_keys.join(", ") }));
+    }
+    info.append(h("span", { class: "state " + (entry.running ? "running" : ""), text: entry.running ? "running" : entry.outcome ? "→ " + entry.outcome : "idle" }));
+    const keys = Object.keys(ud);
+    const table = h("table", { class: "ud-table" });
+    const body = h("tbody");
+    for (const key of keys.sort()) {
+      const value = ud[key];
+      const open = this.expanded.has(key);
+      const valueCell = open
+        ? h("td", { class: "value" }, h("pre", { text: JSON.stringify(value, null, 2) }))
+        : h("td", { class: "value", text: valueText(value, 160) });
+      if (value && typeof value === "object" && ("$repr" in value || "$truncated" in value)) valueCell.classList.add("repr");
+      body.append(h("tr", { class: "ud-row" + (changed?.has(key) ? " changed" : ""), "data-key": key, title: open ? "" : "click to expand" },
+        h("th", { text: key }), valueCell));
+    }
+    table.append(body);
+    this.host.replaceChildren(info, keys.length ? table : h("p", { class: "empty", text: "(no userdata)" }));
+  }
+}

@@ -18,7 +18,7 @@ from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from swagger_ui_bundle import swagger_ui_path
 
-from .control import ControlError
+from .local_control import ControlError
 from .hub import Hub
 from .middleware import SecurityMiddleware
 from .routes import control, ingest, machines, pages, stream

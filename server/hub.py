@@ -14,12 +14,12 @@ import threading
 import time
 from typing import Any, Callable
 
-from fsm import introspection, schema
+from fsm.observation import introspection, schema
 from fsm.observation import structure
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 
-from .control import MachineHandle
+from .local_control import MachineHandle
 from .fanout import Fanout, Feed, Observer
 
 

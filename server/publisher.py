@@ -29,7 +29,7 @@ import urllib.parse
 import weakref
 from typing import Any
 
-from fsm import schema
+from fsm.observation import schema
 from fsm.observation.encoding import dumps, loads
 from fsm.observation.status import Status
 

@@ -11,7 +11,7 @@ import json
 import os
 import re
 
-from fsm import schema
+from fsm.observation import schema
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JS_PATH = os.path.join(ROOT, "static", "schema.js")

@@ -3,7 +3,7 @@ builder, and a structure of any depth."""
 
 from __future__ import annotations
 
-from fsm import schema
+from fsm.observation import schema
 
 
 def ev(seq: int, kind: str, path: str = "/SM_ROOT", machine: str = "m", run: str = "r1", **fields) -> dict:

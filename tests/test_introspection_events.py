@@ -3,7 +3,7 @@
 import fsm as smach
 import fsm.core.log
 import pytest
-from fsm import introspection
+from fsm.observation import introspection
 
 from smach_support import Out, WaitForPreempt, concurrence, machine, preempt_while_running
 

@@ -7,7 +7,7 @@ import os
 
 import fsm
 import pytest
-from fsm import schema
+from fsm.observation import schema
 from fsm.logfiles.log_reader import read_events
 
 from event_support import deep_root, ev, flat_root, run_of

@@ -10,7 +10,7 @@ from fastapi import APIRouter, Body, Path
 from fastapi.concurrency import run_in_threadpool
 
 from .. import models
-from ..control import publish
+from ..local_control import publish
 from .deps import AUTH, ERRORS, ClientAddress, Handle, HubDep
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["control"])

@@ -9,7 +9,7 @@ from starlette.requests import HTTPConnection
 
 from .. import models
 from ..auth import require_token, websocket_refusal
-from ..control import MachineHandle
+from ..local_control import MachineHandle
 from ..hub import Hub, MachineEntry
 from ..middleware import deny_handshake
 

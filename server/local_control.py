@@ -9,7 +9,7 @@ from __future__ import annotations
 import threading
 from typing import Any, Callable
 
-from fsm import introspection
+from fsm.observation import introspection
 from fsm.observation import structure
 
 

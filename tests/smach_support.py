@@ -4,6 +4,7 @@ import threading
 from typing import Any, Callable
 
 import fsm as smach
+import pytest
 
 
 class Out(smach.State):
@@ -105,3 +106,22 @@ def userdata(**values: Any) -> smach.UserData:
     ud = smach.UserData()
     ud.update(values)
     return ud
+
+
+def failing_machine():
+    """SM_ROOT: SUB(BAD raises ValueError) -> done."""
+    def bad(ud):
+        raise ValueError("boom")
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        sub = smach.StateMachine(outcomes=["ok"])
+        with sub:
+            smach.StateMachine.add("BAD", smach.CBState(bad, outcomes=["go"]), {"go": "ok"})
+        smach.StateMachine.add("SUB", sub, {"ok": "done"})
+    return sm
+
+
+def run_to_failure(sm):
+    with pytest.raises(smach.SmachError):
+        sm.execute()

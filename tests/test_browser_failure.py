@@ -9,22 +9,9 @@ import fsm
 import pytest
 from browser_support import watch
 from server.http_server import ServerThread
+from smach_support import failing_machine, run_to_failure
 
 ERROR_RED = "rgb(198, 40, 40)"  # --err of static/style.css
-
-
-def failing_machine():
-    """SM_ROOT: SUB(BAD raises ValueError) -> done."""
-    def bad(ud):
-        raise ValueError("boom")
-
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        sub = fsm.StateMachine(outcomes=["ok"])
-        with sub:
-            fsm.StateMachine.add("BAD", fsm.CBState(bad, outcomes=["go"]), {"go": "ok"})
-        fsm.StateMachine.add("SUB", sub, {"ok": "done"})
-    return sm
 
 
 def calm_machine():
@@ -32,11 +19,6 @@ def calm_machine():
     with sm:
         fsm.StateMachine.add("REST", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "done"})
     return sm
-
-
-def run_to_failure(sm):
-    with pytest.raises(fsm.SmachError):
-        sm.execute()
 
 
 @pytest.fixture(scope="module")

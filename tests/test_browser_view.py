@@ -12,8 +12,8 @@ from browser_support import watch
 from fsm.observation.schema import edge_id, outcome_id
 from server.http_server import ServerThread
 from server_support import nested_machine
+from smach_support import failing_machine, run_to_failure
 
-from test_browser_failure import failing_machine, run_to_failure
 
 # The view of a fresh page's store after `events` (a list of event dicts).
 VIEW_AFTER = """async (events) => {

@@ -20,16 +20,14 @@ Imports only the standard library, ``websockets`` and ``fsm`` (no FastAPI).
 
 from __future__ import annotations
 
-import atexit
 import collections
 import sys
 import threading
 import time
 import urllib.parse
-import weakref
 from typing import Any
 
-from fsm.observation import schema
+from fsm.observation import closing, schema
 from fsm.observation.encoding import dumps, loads
 from fsm.observation.status import Status
 
@@ -67,7 +65,7 @@ class Publisher:
         self.dropped = 0
         self.rejected = 0  # events the server refused (see stderr for why)
         self._thread: threading.Thread | None = None
-        _open_publishers.add(self)
+        closing.close_at_exit(self)
         if start:
             self.start()
 
@@ -95,7 +93,7 @@ class Publisher:
         self._wake.set()
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(max(0.1, deadline - time.monotonic()))
-        _open_publishers.discard(self)
+        closing.closed(self)
 
     def flush(self, timeout: float = 5.0) -> bool:
         """Wait until every buffered event was handed to the socket; False on timeout."""
@@ -184,16 +182,3 @@ class Publisher:
     def _take_all(self) -> None:
         while self._buf:
             self._take()
-
-
-_open_publishers: weakref.WeakSet[Publisher] = weakref.WeakSet()
-
-
-@atexit.register
-def _close_all() -> None:
-    """A script that exits without closing its publisher still sends its last events."""
-    for publisher in list(_open_publishers):
-        try:
-            publisher.close()
-        except Exception:
-            pass

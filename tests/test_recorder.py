@@ -161,3 +161,16 @@ def test_a_recording_killed_with_sigkill_loses_at_most_the_last_100ms(tmp_path):
     events = [e for e in read_events(path) if e["kind"] != "snapshot"]
     assert [e["seq"] for e in events] == list(range(1, len(events) + 1))
     assert events[-1]["t"] >= killed_at - 0.1, "lost %.3f s" % (killed_at - events[-1]["t"])
+
+
+def test_a_script_that_exits_without_closing_its_recorder_has_every_event_written(tmp_path):
+    path = tmp_path / "run.jsonl"
+    script = ("import sys, fsm\n"
+              "sys.path.insert(0, %r)\n"
+              "from recording_support import two_state_loop\n"
+              "recorder = fsm.Recorder(%r, flush_interval=3600, flush_bytes=1 << 30)\n"
+              "fsm.attach(two_state_loop(50), recorder).root.execute()\n"
+              "sys.stderr.write(\"events=%%d\" %% recorder.events)\n") % (os.path.dirname(__file__), str(path))
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert len(_lines(path)) == int(done.stderr.rsplit("events=", 1)[1]) > 100

@@ -17,14 +17,12 @@ exclusive lock knows that nobody writes the file any more (``fsm.logfiles.log_re
 
 from __future__ import annotations
 
-import atexit
 import os
 import threading
 import time
-import weakref
 from typing import Any
 
-from ..observation import encoding
+from ..observation import closing, encoding
 from ..observation import schema
 from ..observation.status import Status
 
@@ -84,7 +82,7 @@ class Recorder:
         self._wake = threading.Event()
         self._writer = threading.Thread(target=self._write_loop, name="fsm-recorder", daemon=True)
         self._writer.start()
-        _open_recorders.add(self)
+        closing.close_at_exit(self)
 
     # The observer call: keep it cheap (an encode, an append and one step of the reducer).
     def __call__(self, event: dict) -> None:
@@ -180,7 +178,7 @@ class Recorder:
                 handle.flush()
                 os.fsync(handle.fileno())
                 handle.close()  # closing the log also releases its flock
-        _open_recorders.discard(self)
+        closing.closed(self)
 
     @property
     def closed(self) -> bool:
@@ -194,16 +192,3 @@ class Recorder:
 
     def __repr__(self) -> str:
         return "Recorder(%r, events=%d%s)" % (self.path, self.events, ", closed" if self._closed else "")
-
-
-_open_recorders: weakref.WeakSet[Recorder] = weakref.WeakSet()
-
-
-@atexit.register
-def _close_all() -> None:
-    """A script that exits without closing its recorder still gets its log flushed and fsynced."""
-    for recorder in list(_open_recorders):
-        try:
-            recorder.close()
-        except Exception:
-            pass

@@ -1,9 +1,10 @@
-"""Helpers of the browser tests: the dashboard's page for a machine of a live server, the
+"""Helpers of the browser tests: the dashboard's page for a machine of a live server (or served alone), the
 active state as the graph shows it, the event log's filter, and Debian's Firefox over WebDriver
 BiDi. Chromium and the demo process are in server.testing (bench/ and docs/ use them too)."""
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 import signal
@@ -12,6 +13,7 @@ import urllib.parse
 from pathlib import Path
 
 from server.testing.browser import open_page
+from server.http_server import ServerThread
 from server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -21,6 +23,20 @@ ACTIVE_LEAF = """(() => {
     ids.sort((a, b) => b.length - a.length);
     return ids[0] || null;
 })()"""
+
+
+@contextlib.contextmanager
+def served_page(browser, machine, name: str, **entry):
+    """A page watching ``machine``, served alone by a fresh server (``entry``: add_local's options);
+    the page must end without a script error."""
+    srv = ServerThread().start()
+    srv.hub.add_local(machine, name=name, **entry)
+    try:
+        page = watch(browser, srv, name)
+        yield page
+        assert not page.errors
+    finally:
+        srv.stop()
 
 
 def watch(browser, server, machine: str):

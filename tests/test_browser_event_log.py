@@ -6,7 +6,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import filter_log, watch
+from browser_support import filter_log, served_page, watch
 from server.http_server import ServerThread
 from smach_support import WaitForPreempt, concurrence, machine
 
@@ -107,20 +107,14 @@ def test_a_concurrence_that_serviced_a_preempt_shows_no_concurrent_outcomes_line
     left, right = WaitForPreempt(), WaitForPreempt()
     sm = machine(["stopped"], [("CC", concurrence(["preempted"], "preempted", [("LEFT", left), ("RIGHT", right)]),
                                 {"preempted": "stopped"})])
-    srv = ServerThread().start()
-    srv.hub.add_local(sm, name="stop")
     runner = threading.Thread(target=sm.execute)
-    try:
-        page = watch(browser, srv, "stop")
+    with served_page(browser, sm, "stop") as page:
         runner.start()
         assert left.started.wait(5) and right.started.wait(5)
         sm.request_preempt()
+        runner.join(10)
         page.wait_for_selector("#run-state:has-text('finished: stopped')")
         page.wait_for_selector("#log .log-row.kind-terminate[data-select='/SM_ROOT']")
         rows = rows_shown(page)
-        assert "log: Concurrence serviced preempt." in rows
-        assert not [row for row in rows if "Concurrent Outcomes" in row], rows
-        assert not page.errors
-    finally:
-        runner.join(10)
-        srv.stop()
+    assert "log: Concurrence serviced preempt." in rows
+    assert not [row for row in rows if "Concurrent Outcomes" in row], rows

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import fsm
 import pytest
-from browser_support import watch
-from server.http_server import ServerThread
+from browser_support import served_page
 
 
 class Arms(fsm.Concurrence):
@@ -28,14 +27,8 @@ def machine_with_a_concurrence_subclass():
 
 @pytest.fixture(scope="module")
 def page(browser):
-    srv = ServerThread().start()
-    srv.hub.add_local(machine_with_a_concurrence_subclass(), name="arms", can_start=True)
-    try:
-        page = watch(browser, srv, "arms")
+    with served_page(browser, machine_with_a_concurrence_subclass(), "arms", can_start=True) as page:
         yield page
-        assert not page.errors
-    finally:
-        srv.stop()
 
 
 def menu_item(page, path: str):

@@ -8,9 +8,8 @@ import json
 
 import fsm
 import pytest
-from browser_support import watch
+from browser_support import served_page
 from fsm.observation.schema import edge_id, outcome_id
-from server.http_server import ServerThread
 from server_support import nested_machine
 from smach_support import failing_machine, run_to_failure
 
@@ -30,14 +29,8 @@ VIEW_AFTER = """async (events) => {
 @pytest.fixture(scope="module")
 def page(browser):
     """A page of the dashboard, there only to import its modules."""
-    srv = ServerThread().start()
-    srv.hub.add_local(nested_machine(), name="nested")
-    try:
-        page = watch(browser, srv, "nested")
+    with served_page(browser, nested_machine(), "nested") as page:
         yield page
-        assert not page.errors
-    finally:
-        srv.stop()
 
 
 def events_of(sm, runs=1, execute=lambda sm: sm.execute()) -> list[dict]:

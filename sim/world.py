@@ -9,6 +9,9 @@ commands land at the same simulated instants whatever the thread scheduling.
 
 The arm follows a :class:`JointPath` evaluated at simulated time inside the physics
 thread; :meth:`World.hold` replaces it by the current joint position.
+
+One piece (about 350 lines) because everything here touches ``MjData`` under the one lock the
+physics thread holds: episode set-up, stepping, the arm's path, the gripper and the readings.
 """
 
 from __future__ import annotations

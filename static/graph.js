@@ -2,7 +2,8 @@
 // sanitized and inlined; status only toggles CSS classes on the stable ids of docs/api.md
 // (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
 // the layout never moves when only the status changes. Pan (drag) and zoom (wheel) act on the
-// SVG's viewBox.
+// SVG's viewBox. One module (about 300 lines): loading, marking and pan/zoom all act on the same
+// inlined SVG and its element index.
 
 import { containerId, outcomeId, stateId } from "./schema.js";
 import { parentPath } from "./status.js";

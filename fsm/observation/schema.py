@@ -10,6 +10,10 @@ what is wrong; an event it refuses never reaches a ``Status``, a graph or a clie
 The graph's element ids (``s:``, ``c:``, ``o:``, ``e:``) are part of the contract between the
 server's SVG and the page, so they are defined here too.
 
+One module of about 400 lines on purpose, like viser's one message module: the definition, the
+builder and the validator must change together, and the generated browser file and docs come
+from this one place.
+
 Standard library only, like the rest of ``fsm``.
 """
 

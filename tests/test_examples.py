@@ -48,7 +48,7 @@ def test_service_action_counts_the_square_with_feedback(tmp_path, monkeypatch):
 
 
 def test_nested_monitor_preempts_itself_when_run_standalone():
-    assert load_example("nested_monitor")["main"](["--time-scale", "0.01"]) == "preempted"
+    assert load_example("nested_monitor")["main"](["--time-scale", "0.01", "--action-seconds", "1000"]) == "preempted"
 
 
 def test_nested_monitor_is_preempted_by_a_message_from_outside():

@@ -28,7 +28,7 @@ def test_nested_concurrence_replays_the_live_log_lines_word_for_word(tmp_path, l
     server = example["start_action_server"](0.01)
     try:
         path = tmp_path / "run.jsonl"
-        sm = example["build"](0.01)
+        sm = example["build"](0.01, action_seconds=1000)  # the stop (0.03 s) always comes first
         logs.all.clear()
         outcome, _ = record(sm, path)
     finally:

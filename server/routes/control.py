@@ -1,5 +1,5 @@
 """What a page can do to a machine of this process: preempt, hold, set its initial state, start it,
-and publish on the in-process bus. The machine's side is server/control.py; its calls may block
+and publish on the in-process bus. The machine's side is server/local_control.py; its calls may block
 briefly on the machine's locks, so they run in a worker thread, never on the event loop."""
 
 from __future__ import annotations

@@ -125,3 +125,23 @@ def failing_machine():
 def run_to_failure(sm):
     with pytest.raises(smach.SmachError):
         sm.execute()
+
+
+def two_level_machine(first=None):
+    """SM_ROOT: [FIRST ->] SUB(A -> B) -> done; B writes SUB's `x`. ``first``: a state run before SUB."""
+    def write(ud):
+        ud.x = ud.x + 1
+        return "go"
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        if first is not None:
+            smach.StateMachine.add("FIRST", first, {"go": "SUB"})
+        sub = smach.StateMachine(outcomes=["ok"])
+        sub.userdata.x = 0
+        with sub:
+            smach.StateMachine.add("A", smach.CBState(lambda ud: "go", outcomes=["go"]), {"go": "B"})
+            smach.StateMachine.add("B", smach.CBState(write, outcomes=["go"], input_keys=["x"], output_keys=["x"]),
+                                   {"go": "ok"})
+        smach.StateMachine.add("SUB", sub, {"ok": "done"})
+    return sm

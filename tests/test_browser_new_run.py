@@ -8,27 +8,14 @@ import fsm
 import pytest
 from browser_support import watch
 from server.http_server import ServerThread
+from smach_support import two_level_machine
 
 SUB = "/SM_ROOT/SUB"
 
 
 def gated_machine(gate: threading.Event):
     """SM_ROOT: FIRST (waits for `gate`) -> SUB(A -> B, B writes SUB's `x`) -> done."""
-    def write(ud):
-        ud.x = ud.x + 1
-        return "go"
-
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        fsm.StateMachine.add("FIRST", fsm.CBState(lambda ud: gate.wait(30) and "go", outcomes=["go"]), {"go": "SUB"})
-        sub = fsm.StateMachine(outcomes=["ok"])
-        sub.userdata.x = 0
-        with sub:
-            fsm.StateMachine.add("A", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "B"})
-            fsm.StateMachine.add("B", fsm.CBState(write, outcomes=["go"], input_keys=["x"], output_keys=["x"]),
-                                 {"go": "ok"})
-        fsm.StateMachine.add("SUB", sub, {"ok": "done"})
-    return sm
+    return two_level_machine(first=fsm.CBState(lambda ud: gate.wait(30) and "go", outcomes=["go"]))
 
 
 @pytest.fixture(scope="module")

@@ -1,28 +1,10 @@
 """fsm.observation.status: a start of the root container begins a new run, and the state shows that run only."""
 
-import fsm
 import pytest
 from fsm.observation.status import Status
+from smach_support import two_level_machine
 
 SUB = "/SM_ROOT/SUB"
-
-
-def two_level_machine():
-    """SM_ROOT: SUB(A -> B) -> done; B writes SUB's `x`."""
-    def write(ud):
-        ud.x = ud.x + 1
-        return "go"
-
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        sub = fsm.StateMachine(outcomes=["ok"])
-        sub.userdata.x = 0
-        with sub:
-            fsm.StateMachine.add("A", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "B"})
-            fsm.StateMachine.add("B", fsm.CBState(write, outcomes=["go"], input_keys=["x"], output_keys=["x"]),
-                                 {"go": "ok"})
-        fsm.StateMachine.add("SUB", sub, {"ok": "done"})
-    return sm
 
 
 @pytest.fixture

@@ -1,5 +1,6 @@
 """fsm.observation.status: a start of the root container begins a new run, and the state shows that run only."""
 
+import fsm
 import pytest
 from fsm.observation.status import Status
 from smach_support import two_level_machine

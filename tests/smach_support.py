@@ -145,3 +145,11 @@ def two_level_machine(first=None):
                                    {"go": "ok"})
         smach.StateMachine.add("SUB", sub, {"ok": "done"})
     return sm
+
+
+def one_state_machine(label: str, state: smach.State) -> smach.StateMachine:
+    """SM_ROOT: ``label`` (``state``) -done-> done."""
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        smach.StateMachine.add(label, state, {"done": "done"})
+    return sm

@@ -7,9 +7,8 @@ import threading
 
 import fsm
 import pytest
-from browser_support import watch
+from browser_support import served_page
 from fsm.observation.schema import edge_id, state_id
-from server.http_server import ServerThread
 
 PERCENT = "100%"
 VT = "VT\x0bBAD"
@@ -30,19 +29,16 @@ def waiting_in_vt(browser):  # noqa: F811
     fsm.set_loggers(*(lambda msg: None,) * 4)
     gate = threading.Event()
     sm = odd_machine(gate)
-    srv = ServerThread().start()
-    srv.hub.add_local(sm, name="odd")
     runner = threading.Thread(target=sm.execute)
     try:
-        page = watch(browser, srv, "odd")
-        runner.start()
-        page.wait_for_selector("#run-state.running")
-        yield page
-        assert not page.errors
+        with served_page(browser, sm, "odd") as page:
+            runner.start()
+            page.wait_for_selector("#run-state.running")
+            yield page
     finally:
         gate.set()
-        runner.join(10)
-        srv.stop()
+        if runner.is_alive():
+            runner.join(10)
 
 
 def has_class(page, element_id: str, cls: str) -> None:

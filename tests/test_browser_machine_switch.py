@@ -7,13 +7,7 @@ import threading
 import fsm
 from browser_support import watch
 from server_support import Stubborn
-
-
-def one_state_machine(label, state):
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        fsm.StateMachine.add(label, state, {"done": "done"})
-    return sm
+from smach_support import one_state_machine
 
 
 def test_the_preempt_notice_of_one_machine_is_not_shown_on_another(browser, live_server):

@@ -8,9 +8,9 @@ import threading
 
 import fsm
 import pytest
-from browser_support import watch
+from browser_support import served_page
 from server_support import Stubborn
-from server.http_server import ServerThread
+from smach_support import one_state_machine
 
 OVERDUE = re.compile(r"^Preempt requested (\d+) s ago: /SM_ROOT/STUBBORN has not serviced it$")
 
@@ -20,25 +20,20 @@ def preempted(browser):  # noqa: F811
     """A page that preempted a machine whose only state ignores it."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     stubborn = Stubborn()
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        fsm.StateMachine.add("STUBBORN", stubborn, {"done": "done"})
-    srv = ServerThread().start()
-    srv.hub.add_local(sm, name="stubborn")
+    sm = one_state_machine("STUBBORN", stubborn)
     runner = threading.Thread(target=sm.execute)
-    runner.start()
     try:
-        page = watch(browser, srv, "stubborn")
-        page.wait_for_selector("#run-state.running")
-        page.click("#preempt-btn")
-        page.click("#preempt-confirm")
-        page.wait_for_selector("#notice:has-text('Preempt accepted')")
-        yield page
-        assert not page.errors
+        with served_page(browser, sm, "stubborn") as page:
+            runner.start()
+            page.wait_for_selector("#run-state.running")
+            page.click("#preempt-btn")
+            page.click("#preempt-confirm")
+            page.wait_for_selector("#notice:has-text('Preempt accepted')")
+            yield page
     finally:
         stubborn.release.set()
-        runner.join(10)
-        srv.stop()
+        if runner.is_alive():
+            runner.join(10)
 
 
 def overdue_seconds(page) -> int:

@@ -176,13 +176,13 @@ function render() {
   renderQueued = false;
   const s = store.status;
   if (!s) return;
-  const shown = view(s, store.marks);
+  const shown = view(s);
   graph.apply({ ...shown, selected: store.selected });
   tree.update(s, shown.failed);
   log.flush();
   machines.fillPicker();
   const udPath = userdata.path;
-  userdata.update(s, udPath ? store.nodes.get(udPath) : null, udPath ? store.marks.changed.get(udPath) : null);
+  userdata.update(s, udPath ? store.nodes.get(udPath) : null);
   updateTopBar();
 }
 

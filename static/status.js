@@ -4,7 +4,18 @@
 const REDUCED = new Set(["start", "transition", "userdata", "terminate", "error"]);
 
 function containerEntry(initial) {
-  return { active: [], initial: [...(initial || [])], userdata: {}, running: false, outcome: null };
+  return {
+    active: [], initial: [...(initial || [])], userdata: {}, running: false, outcome: null,
+    last: null, changes: {}, written: false,
+  };
+}
+
+/** The container left a state: its last transition is `last`, and the keys written since the
+ * previous one are what this one changed (none when nothing was written). */
+function settle(entry, last) {
+  if (!entry.written) entry.changes = {};
+  entry.written = false;
+  entry.last = last;
 }
 
 /** The path of the container holding `path` (null for the root). */
@@ -43,6 +54,7 @@ export class Status {
     this.run_seq = 0; // the seq of the current run's first event: where its history starts
     // A preempt requested and not over yet: {seq, t, path, serviced: [paths that serviced it]}.
     this.preempt = null;
+    this.pose = null; // the last pose event's {seq, t, joints, bodies}
   }
 
   apply(event) {
@@ -67,6 +79,10 @@ export class Status {
       this._preempt(event);
       return;
     }
+    if (kind === "pose") {
+      this.pose = { seq: event.seq, t: event.t, joints: event.joints, bodies: event.bodies || {} };
+      return;
+    }
     if (!REDUCED.has(kind)) return;
     let entry = this.containers[path];
     if (entry === undefined) entry = this.containers[path] = containerEntry();
@@ -78,18 +94,33 @@ export class Status {
         this.error = null;
         this.preempt = null;
         for (const other of Object.values(this.containers)) {
-          Object.assign(other, { active: [], running: false, outcome: null });
+          Object.assign(other, { active: [], running: false, outcome: null, last: null, changes: {}, written: false });
         }
       }
       Object.assign(entry, {
         active: [...event.active], initial: [...event.initial],
-        userdata: { ...event.userdata }, running: true, outcome: null,
+        userdata: { ...event.userdata }, running: true, outcome: null, last: null, changes: {}, written: false,
       });
     } else if (kind === "transition") {
       entry.active = [...event.active];
+      settle(entry, { from: event.from, outcome: event.outcome, to: event.to, seq: event.seq });
     } else if (kind === "userdata") {
-      Object.assign(entry.userdata, event.changes);
+      const userdata = entry.userdata;
+      if (!entry.written) {
+        entry.changes = {};
+        entry.written = true;
+      }
+      for (const [key, value] of Object.entries(event.changes)) {
+        let change = entry.changes[key];
+        if (change === undefined) change = entry.changes[key] = Object.hasOwn(userdata, key) ? { old: userdata[key] } : {};
+        change.new = value;
+      }
+      Object.assign(userdata, event.changes);
     } else if (kind === "terminate") {
+      const last = event.last;
+      const stateOutcome = event.state_outcome;
+      settle(entry, last.length === 1 && stateOutcome
+        ? { from: last[0], outcome: stateOutcome, to: event.outcome, seq: event.seq } : entry.last);
       Object.assign(entry, { active: [], running: false, outcome: event.outcome });
       if (root) {
         this.running = false;
@@ -153,7 +184,7 @@ export class Status {
       machine: this.machine, run: this.run, root_path: this.root_path, structure: this.structure,
       containers: structuredClone(this.containers), running: this.running, outcome: this.outcome,
       error: this.error, last_seq: this.last_seq, last_t: this.last_t, run_seq: this.run_seq,
-      preempt: structuredClone(this.preempt),
+      preempt: structuredClone(this.preempt), pose: this.pose,
     };
   }
 
@@ -169,6 +200,12 @@ export class Status {
     this.last_t = data.last_t ?? this.last_t;
     this.run_seq = data.run_seq ?? 0;
     this.preempt = structuredClone(data.preempt ?? null);
+    this.pose = data.pose ?? null;
+    for (const entry of Object.values(this.containers)) { // a snapshot of an older fsmscope lacks these
+      entry.last ??= null;
+      entry.changes ??= {};
+      entry.written ??= false;
+    }
   }
 
   static fromDict(data) {

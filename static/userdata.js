@@ -4,7 +4,7 @@
 import { h } from "./dom.js";
 import { valueText } from "./transcript.js";
 
-/** One container's userdata, with the keys written by the last transition highlighted. */
+/** One container's userdata, with the keys written by its last transition highlighted, old -> new. */
 export class UserdataPanel {
   constructor(host, picker, handlers) {
     this.host = host;
@@ -12,7 +12,7 @@ export class UserdataPanel {
     this.handlers = handlers;
     this.path = null;
     this.expanded = new Set();
-    this.rendered = null; // [path, userdata object, changed set] last drawn
+    this.rendered = null; // the key of what was last drawn (path, userdata, changes, state)
     picker.addEventListener("change", () => this.handlers.pick(picker.value));
     host.addEventListener("click", (e) => {
       const row = e.target.closest(".ud-row");
@@ -39,12 +39,13 @@ export class UserdataPanel {
     if (path) this.picker.value = path;
   }
 
-  update(status, node, changed) {
+  update(status, node) {
     const entry = this.path ? status.containers[this.path] : null;
     const ud = entry ? entry.userdata : null;
-    const r = this.rendered;
-    if (r && r[0] === this.path && r[1] === JSON.stringify(ud) && r[2] === changed && r[3] === entry?.running) return;
-    this.rendered = [this.path, JSON.stringify(ud), changed, entry?.running];
+    const changes = entry?.changes || {};
+    const key = JSON.stringify([this.path, ud, changes, entry?.running, entry?.outcome]);
+    if (this.rendered === key) return;
+    this.rendered = key;
     if (!entry) {
       this.host.replaceChildren(h("p", { class: "empty", text: this.path ? "No data for this container yet." : "Select a container." }));
       return;
@@ -66,10 +67,18 @@ export class UserdataPanel {
         ? h("td", { class: "value" }, h("pre", { text: JSON.stringify(value, null, 2) }))
         : h("td", { class: "value", text: valueText(value, 160) });
       if (value && typeof value === "object" && ("$repr" in value || "$truncated" in value)) valueCell.classList.add("repr");
-      body.append(h("tr", { class: "ud-row" + (changed?.has(key) ? " changed" : ""), "data-key": key, title: open ? "" : "click to expand" },
+      const change = Object.hasOwn(changes, key) ? changes[key] : null;
+      if (change) valueCell.append(changeNote(change));
+      body.append(h("tr", { class: "ud-row" + (change ? " changed" : ""), "data-key": key, title: open ? "" : "click to expand" },
         h("th", { text: key }), valueCell));
     }
     table.append(body);
     this.host.replaceChildren(info, keys.length ? table : h("p", { class: "empty", text: "(no userdata)" }));
   }
+}
+
+/** "was OLD" (or "new key") under a value its container's last transition changed. */
+function changeNote(change) {
+  const text = Object.hasOwn(change, "old") ? "was " + valueText(change.old, 80) : "new key";
+  return h("div", { class: "ud-change", text });
 }

@@ -20,7 +20,7 @@ VIEW_AFTER = """async (events) => {
     const store = new Store();
     store.open('m');
     for (const e of events) store.apply(e);
-    const shown = view(store.status, store.marks);
+    const shown = view(store.status);
     for (const list of Object.values(shown)) list.sort();
     return shown;
 }"""

@@ -173,6 +173,18 @@ OBJECT = Type("an object", lambda v: ("must be an object, not %s" % _what(v)) if
 LIST_STR = _list_of(STR, "a list of strings", _all_str)
 MAP_STR = _object_of(STR, "an object of strings")
 MAP_OPT_STR = _object_of(OPT_STR, "an object of strings or nulls")
+MAP_NUMBER = _object_of(NUMBER, "an object of finite numbers")
+
+
+def _sized(t: Type, n: int) -> Type:
+    """``t`` (a list type) holding exactly ``n`` items."""
+    def check(v: Any) -> str | None:
+        return t.check(v) or (None if len(v) == n else "must hold %d items, not %d" % (n, len(v)))
+    return Type(t.name, check, t.types, lambda v: len(v) == n and t.ok(v))
+
+
+BODY_POSE = _sized(_list_of(NUMBER, "a list of 7 finite numbers (x, y, z, qw, qx, qy, qz)"), 7)
+MAP_BODY_POSE = _object_of(BODY_POSE, "an object of body poses")
 
 
 def _join(where: str, problem: str) -> str:
@@ -253,10 +265,22 @@ def node_problem(node: Any, path: str | None = None) -> str | None:
 
 NODE = Type("a structure node (below)", lambda v: node_problem(v))
 
+LAST_TRANSITION_FIELDS = (Field("from", STR, doc="the state that returned"), Field("outcome", STR),
+                          Field("to", OPT_STR, doc="the next state, or the container's outcome when it ended"),
+                          Field("seq", SEQ, doc="the event's"))
 CONTAINER_STATUS_FIELDS = (Field("active", LIST_STR, doc="active children's labels"),
                            Field("initial", LIST_STR, doc="initial children's labels"),
                            Field("userdata", OBJECT, doc="its userdata, encoded"),
-                           Field("running", BOOL), Field("outcome", OPT_STR, doc="its last outcome"))
+                           Field("running", BOOL), Field("outcome", OPT_STR, doc="its last outcome"),
+                           Field("last", _nullable(Type("a transition", lambda v: _fields_problem(
+                               v, LAST_TRANSITION_FIELDS))), required=False,
+                               doc="its last transition in this run: {from, outcome, to, seq}"),
+                           Field("changes", _object_of(OBJECT, "an object of {old, new} objects"), required=False,
+                                 doc="the keys its last transition wrote: {key: {old (absent: a new key), new}}"),
+                           Field("written", BOOL, required=False,
+                                 doc="its userdata was written since its last transition"))
+POSE_FIELDS = (Field("seq", SEQ, doc="the pose event's"), Field("t", NUMBER),
+               Field("joints", MAP_NUMBER), Field("bodies", MAP_BODY_POSE, required=False))
 PREEMPT_FIELDS = (Field("seq", SEQ, doc="the preempt event's"), Field("t", NUMBER, doc="when it was requested"),
                   Field("path", PATH, doc="of the container it was requested of"),
                   Field("serviced", LIST_STR, doc="paths of the states that serviced it so far"))
@@ -271,6 +295,8 @@ STATUS_FIELDS = (
     Field("run_seq", SEQ, required=False, doc="the seq of the current run's first event"),
     Field("preempt", _nullable(Type("a pending preempt", lambda v: _fields_problem(v, PREEMPT_FIELDS))),
           required=False, doc="a preempt requested and not over yet (below)"),
+    Field("pose", _nullable(Type("a pose", lambda v: _fields_problem(v, POSE_FIELDS))), required=False,
+          doc="the robot's last recorded pose: {seq, t, joints, bodies}"),
 )
 STATUS = Type("a machine status (fsm.observation.status.Status.to_dict())",
               lambda v: _fields_problem(v, STATUS_FIELDS))
@@ -321,6 +347,10 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
         Field("reason", OPT_STR, required=False, doc="the operator's words"),
         Field("client", STR, doc="who asked (an address)"), Field("result", STR, doc="'accepted' or why not"),
         Field("params", OBJECT, required=False, doc="what was asked"))),
+    Kind("pose", "The robot's pose, sampled at the rate the 3D view draws it (the demo: 30 Hz).", (
+        Field("joints", MAP_NUMBER, doc="joint positions by joint name (radians, metres)"),
+        Field("bodies", MAP_BODY_POSE, required=False,
+              doc="free bodies' poses by name: [x, y, z, qw, qx, qy, qz] in the world frame"))),
     Kind("snapshot", "The full rebuilt state of one machine at seq.", (
         Field("status", STATUS, doc="the machine's state after the event seq"),)),
 )}

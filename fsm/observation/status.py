@@ -13,11 +13,22 @@ from .structure import containers
 
 
 def _container_entry(initial: list[str] | None = None) -> dict:
-    return {"active": [], "initial": list(initial or []), "userdata": {}, "running": False, "outcome": None}
+    return {"active": [], "initial": list(initial or []), "userdata": {}, "running": False, "outcome": None,
+            "last": None, "changes": {}, "written": False}
+
+
+def _settle(entry: dict, last: dict | None) -> None:
+    """The container left a state: its last transition is ``last``, and the keys written since the
+    previous one are what this one changed (none when nothing was written)."""
+    if not entry.get("written"):
+        entry["changes"] = {}
+    entry["written"] = False
+    entry["last"] = last
 
 
 class Status:
-    """Per machine: structure, and per container path its active/initial states, userdata, outcome."""
+    """Per machine: structure, and per container path its active/initial states, userdata, outcome,
+    last transition and the userdata keys that transition changed (old and new values); the robot's pose."""
 
     def __init__(self, machine: str) -> None:
         self.machine = machine
@@ -33,6 +44,7 @@ class Status:
         self.run_seq = 0  # the seq of the current run's first event: where its history starts
         # A preempt requested and not over yet: {"seq", "t", "path", "serviced": [paths that serviced it]}.
         self.preempt: dict | None = None
+        self.pose: dict | None = None  # the last pose event's {seq, t, joints, bodies}
 
     def apply(self, event: dict) -> None:
         kind = event["kind"]
@@ -51,6 +63,10 @@ class Status:
         if kind == "preempt":
             self._preempt(event)
             return
+        if kind == "pose":
+            self.pose = {"seq": event["seq"], "t": event["t"], "joints": event["joints"],
+                         "bodies": event.get("bodies", {})}
+            return
         if kind not in ("start", "transition", "userdata", "terminate", "error"):
             return
         entry = self.containers.get(path)
@@ -61,14 +77,30 @@ class Status:
             if root:  # a new run: what the previous one reached no longer describes the machine
                 self.running, self.outcome, self.error, self.preempt = True, None, None, None
                 for other in self.containers.values():
-                    other.update(active=[], running=False, outcome=None)
+                    other.update(active=[], running=False, outcome=None, last=None, changes={}, written=False)
             entry.update(active=list(event["active"]), initial=list(event["initial"]),
-                         userdata=dict(event["userdata"]), running=True, outcome=None)
+                         userdata=dict(event["userdata"]), running=True, outcome=None, last=None, changes={},
+                         written=False)
         elif kind == "transition":
             entry["active"] = event["active"]  # events are never changed once emitted: no copy
+            _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"],
+                            "seq": event["seq"]})
         elif kind == "userdata":
-            entry["userdata"].update(event["changes"])
+            userdata = entry["userdata"]
+            if not entry.get("written"):
+                entry["changes"], entry["written"] = {}, True
+            changes = entry["changes"]
+            for key, new in event["changes"].items():
+                change = changes.get(key)
+                if change is None:
+                    change = changes[key] = {"old": userdata[key]} if key in userdata else {}
+                change["new"] = new
+            userdata.update(event["changes"])
         elif kind == "terminate":
+            last = event["last"]
+            state_outcome = event.get("state_outcome")
+            _settle(entry, {"from": last[0], "outcome": state_outcome, "to": event["outcome"], "seq": event["seq"]}
+                    if len(last) == 1 and state_outcome else entry.get("last"))
             entry.update(active=[], running=False, outcome=event["outcome"])
             if root:
                 self.running, self.outcome, self.preempt = False, event["outcome"], None
@@ -111,7 +143,8 @@ class Status:
         return {"machine": self.machine, "run": self.run, "root_path": self.root_path, "structure": self.structure,
                 "containers": copy.deepcopy(self.containers), "running": self.running, "outcome": self.outcome,
                 "error": self.error, "last_seq": self.last_seq, "last_t": self.last_t, "run_seq": self.run_seq,
-                "preempt": None if self.preempt is None else dict(self.preempt, serviced=list(self.preempt["serviced"]))}
+                "preempt": None if self.preempt is None else dict(self.preempt, serviced=list(self.preempt["serviced"])),
+                "pose": self.pose}
 
     def _load(self, data: dict) -> None:
         self.run = data.get("run")
@@ -125,6 +158,11 @@ class Status:
         self.last_t = data.get("last_t", self.last_t)
         self.run_seq = data.get("run_seq", 0)
         self.preempt = copy.deepcopy(data.get("preempt"))
+        self.pose = data.get("pose")
+        for entry in self.containers.values():  # a snapshot of an older fsmscope lacks these
+            entry.setdefault("last", None)
+            entry.setdefault("changes", {})
+            entry.setdefault("written", False)
 
     @classmethod
     def from_dict(cls, data: dict) -> Status:

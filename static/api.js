@@ -38,16 +38,29 @@ async function request(method, url, body, accept = "json") {
 
 const machine = (name) => "/api/machines/" + encodeURIComponent(name);
 
+/** `?a=1&b=2&b=3` of the defined entries of `params`, an array giving a key once per item ("" when none). */
+function query(params) {
+  const qs = new URLSearchParams();
+  for (const [key, value] of Object.entries(params || {})) {
+    for (const item of [].concat(value ?? [])) qs.append(key, item);
+  }
+  const text = qs.toString();
+  return text ? "?" + text : "";
+}
+
 export const api = {
   machines: () => request("GET", "/api/machines"),
   scene: () => request("GET", "/api/scene"),
   status: (name) => request("GET", machine(name) + "/status"),
-  graphSvg(name, expand) {
-    const query = new URLSearchParams();
-    for (const path of expand || []) query.append("expand", path);
-    const qs = query.toString();
-    return request("GET", machine(name) + "/graph.svg" + (qs ? "?" + qs : ""), undefined, "text");
-  },
+  /** The status right after event {seq}, or after the last event at time {t} (docs/api.md, "Time travel"). */
+  statusAt: (name, at) => request("GET", machine(name) + "/status" + query(at)),
+  /** A page of the machine's events: {since, until, limit, kinds, path, order}. */
+  history: (name, params) => request("GET", machine(name) + "/history" + query(params)),
+  /** Bands, ticks and runs of the machine's timeline: {since_t, until_t, buckets}. */
+  timeline: (name, params) => request("GET", machine(name) + "/timeline" + query(params)),
+  /** Show a recorded pose in the 3D view (null: back to the live arm). */
+  scenePose: (pose) => request("POST", "/api/scene/pose", { pose }),
+  graphSvg: (name, expand) => request("GET", machine(name) + "/graph.svg" + query({ expand }), undefined, "text"),
   preempt: (name, reason) => request("POST", machine(name) + "/preempt", { reason: reason || "" }),
   setInitialState: (name, path, states, userdata) =>
     request("POST", machine(name) + "/initial-state", { path, states, userdata }),

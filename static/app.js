@@ -1,8 +1,11 @@
-// Wiring: the machine shown (store.js), fed by its stream, drawn by the graph and the panels; the
-// picker (machines.js), controls (controls.js), depth (depth.js), notices and badge around it.
+// Wiring: the machine shown (store.js), fed by its stream, drawn by the graph and the panels at the
+// instant the playhead (timetravel.js) says, live or past; the picker (machines.js), controls
+// (controls.js), depth (depth.js), notices and badge around it.
 
 import { api } from "./api.js";
 import { showBadge } from "./badge.js";
+import { clockText } from "./clocktext.js";
+import { readLink, writeLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
 import { Depth } from "./depth.js";
 import { showMenu } from "./dialogs.js";
@@ -10,8 +13,9 @@ import { GraphView } from "./graph.js";
 import { Machines, isReplay, showRunState } from "./machines.js";
 import { RunNotices, notice } from "./notice.js";
 import { EventLog } from "./eventlog.js";
+import { Playhead } from "./timetravel.js";
 import { TreeView } from "./tree.js";
-import { UserdataPanel } from "./userdata.js";
+import { UserdataPanel, keyHistory } from "./userdata.js";
 import { SceneView } from "./scene.js";
 import { SCHEMA_VERSION } from "./schema.js";
 import { containers, parentPath } from "./status.js";
@@ -23,6 +27,12 @@ const $ = (id) => document.getElementById(id);
 const store = new Store();
 let stream = null; // the stream of the machine shown
 let renderQueued = false;
+const KEY_HISTORY_LIMIT = 10000; // events of a run read for one key's history
+
+const playhead = new Playhead(api, {
+  changed: () => queueRender(),
+  failed: (err) => notice("Could not show that instant: " + (err.detail || err.message), "warn"),
+});
 
 const graph = new GraphView($("graph"), {
   select: (path) => select(path),
@@ -40,12 +50,19 @@ const tree = new TreeView($("tree"), {
 const userdata = new UserdataPanel($("userdata"), $("ud-container"), {
   pick: (path) => select(path),
   redraw: () => queueRender(),
+  keyHistory: (path, key) => showKeyHistory(path, key),
+  seek: (seq) => playhead.seek({ seq }),
 });
 const log = new EventLog($("log"), {
   kinds: $("log-kinds"), text: $("log-filter"), count: $("log-count"), clear: $("log-clear"), partial: $("log-partial"),
-}, { select: (path) => select(path) });
+}, {
+  select: (path, seq) => {
+    select(path);
+    if (Number.isSafeInteger(seq)) playhead.seek({ seq });
+  },
+});
 log.nodeOf = (path) => store.nodes.get(path);
-const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"));
+const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"), api.scenePose);
 const notices = new RunNotices();
 const machines = new Machines($("machine-picker"), store, {
   open: (name) => openMachine(name),
@@ -62,6 +79,8 @@ const depth = new Depth($("depth"), store, () => graph.openPaths(), () => loadGr
 function openMachine(name) {
   if (stream) stream.stop();
   store.open(name);
+  const link = readLink();
+  playhead.open(name, isReplay(machines.list.find((m) => m.name === name)), link.machine === name ? link.seq : null);
   machines.opened(name);
   depth.reset();
   notices.forget(); // they were about the machine shown so far
@@ -129,6 +148,19 @@ async function loadGraph() {
   }
 }
 
+/** The history of `key` of container `path` in the current run, beside the userdata. */
+async function showKeyHistory(path, key) {
+  const name = store.name;
+  const s = shownStatus();
+  try {
+    const page = await api.history(name, { since: s.run_seq, until: s.last_seq, path, kinds: "start,transition,userdata",
+      limit: KEY_HISTORY_LIMIT });
+    if (name === store.name) userdata.showHistory(key, keyHistory(page.events, key), page.more);
+  } catch (err) {
+    notice("Could not read the history of " + key + ": " + (err.detail || err.message), "warn");
+  }
+}
+
 // ---------------------------------------------------------------- selection and the state menu
 
 function select(path) {
@@ -172,14 +204,47 @@ function queueRender() {
   requestAnimationFrame(render);
 }
 
+/** The status of the instant shown: the playhead's when it looks back, else the stream's present. */
+function shownStatus() {
+  return playhead.past && playhead.status ? playhead.status : store.status;
+}
+
+/** The bar that says the page looks back, how far, and how to come back. */
+function showPast() {
+  const bar = $("past");
+  bar.hidden = !playhead.past;
+  if (!playhead.past) return;
+  const replay = playhead.replay;
+  const behind = playhead.behind(store.status);
+  const at = `${clockText(playhead.t)}, event ${playhead.seq}`;
+  $("past-text").textContent = replay ? `replay: ${at}${playhead.playing ? ` (playing ×${playhead.speed})` : ""}`
+    : `viewing the past: ${clockText(playhead.t)}, ${behind} event${behind === 1 ? "" : "s"} behind`;
+  $("back-live").hidden = replay;
+}
+
+let linkTimer = null;
+/** The address names the instant shown (at most four times a second: browsers throttle replaceState). */
+function updateLink() {
+  if (linkTimer) return;
+  linkTimer = setTimeout(() => {
+    linkTimer = null;
+    if (store.name !== null) writeLink(store.name, playhead.past ? playhead.seq : null);
+  }, 250);
+}
+
 function render() {
   renderQueued = false;
-  const s = store.status;
-  if (!s) return;
+  if (!store.status) return;
+  const s = shownStatus();
   const shown = view(s);
   graph.apply({ ...shown, selected: store.selected });
   tree.update(s, shown.failed);
+  if (playhead.past && !playhead.window) log.freeze();
+  else log.showPast(playhead.past ? playhead.window : null);
   log.flush();
+  showPast();
+  scene.showPose(playhead.past ? s.pose : null);
+  updateLink();
   machines.fillPicker();
   const udPath = userdata.path;
   userdata.update(s, udPath ? store.nodes.get(udPath) : null);
@@ -189,6 +254,7 @@ function render() {
 // ---------------------------------------------------------------- go
 
 $("fit").addEventListener("click", () => graph.fit());
+$("back-live").addEventListener("click", () => playhead.live());
 $("zoom-in").addEventListener("click", () => graph.zoom(1.25));
 $("zoom-out").addEventListener("click", () => graph.zoom(0.8));
 $("follow").addEventListener("change", (e) => {
@@ -204,10 +270,12 @@ document.addEventListener("keydown", (e) => {
 setInterval(updateBadge, 500);
 setInterval(() => notices.checkOverdue(store.status), 500);
 
-// Read-only, for the console and the browser tests (the selected path, the status shown).
+// Read-only, for the console and the browser tests (the selected path, the status shown, the live one).
 window.fsmscope = Object.freeze({
   get name() { return store.name; },
-  get status() { return store.status; },
+  get status() { return shownStatus(); },
+  get liveStatus() { return store.status; },
+  get instant() { return { past: playhead.past, seq: playhead.seq, t: playhead.t, playing: playhead.playing }; },
   get selected() { return store.selected; },
 });
 machines.poll();

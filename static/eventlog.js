@@ -1,6 +1,7 @@
 // The event log: every event as SMACH's line (transcript.js), filtered by kind and text.
 // Every name, value and message goes in as text (createElement + textContent), never as HTML.
 
+import { clockText } from "./clocktext.js";
 import { h } from "./dom.js";
 import { KINDS } from "./schema.js";
 import { Transcript } from "./transcript.js";
@@ -8,6 +9,7 @@ import { Transcript } from "./transcript.js";
 const MAX_EVENTS = 5000;
 const MAX_ROWS = 800;
 const MAX_ROWS_PER_FRAME = 120; // under a flood only the newest rows of each frame are drawn
+const HIDDEN_AT_FIRST = new Set(["pose"]); // 30 a second: shown only when asked for
 
 function selectionOf(ev) {
   const path = ev.path;
@@ -15,13 +17,6 @@ function selectionOf(ev) {
   if (ev.kind === "start" && ev.active?.length === 1) return path + "/" + ev.active[0];
   if (ev.kind === "error" && ev.state) return path + "/" + ev.state;
   return path;
-}
-
-function clock(t) {
-  if (typeof t !== "number") return "";
-  const d = new Date(t * 1000);
-  const pad = (n, w = 2) => String(n).padStart(w, "0");
-  return `${pad(d.getHours())}:${pad(d.getMinutes())}:${pad(d.getSeconds())}.${pad(d.getMilliseconds(), 3)}`;
 }
 
 /** The words of an event the text filter searches besides its transcript line: the states and outcomes it names. */
@@ -35,7 +30,7 @@ function searchedWords(ev) {
 class KindFilter {
   constructor(details, changed) {
     this.summary = details.querySelector("summary");
-    this.boxes = KINDS.map((kind) => h("input", { type: "checkbox", value: kind, checked: true }));
+    this.boxes = KINDS.map((kind) => h("input", { type: "checkbox", value: kind, checked: !HIDDEN_AT_FIRST.has(kind) }));
     details.querySelector(".kinds-actions").before(...this.boxes.map((box) => h("label", {}, box, " " + box.value)));
     this._read();
     const update = () => {
@@ -62,11 +57,14 @@ class KindFilter {
   _read() {
     this.hidden = new Set(this.boxes.filter((b) => !b.checked).map((b) => b.value)); // the kinds not shown
     const shown = this.boxes.length - this.hidden.size;
-    this.summary.textContent = !this.hidden.size ? "all kinds" : shown ? `${shown} of ${this.boxes.length} kinds` : "no kinds";
+    const asAtFirst = this.hidden.size === HIDDEN_AT_FIRST.size && [...HIDDEN_AT_FIRST].every((k) => this.hidden.has(k));
+    this.summary.textContent = !this.hidden.size ? "all kinds" : asAtFirst ? `all kinds but ${[...HIDDEN_AT_FIRST].join(", ")}`
+      : shown ? `${shown} of ${this.boxes.length} kinds` : "no kinds";
   }
 }
 
-/** The event log, filtered by kinds and by text; clicking a row selects the state it is about. */
+/** The event log, filtered by kinds and by text; clicking a row selects the state it is about and
+ * jumps to its event. Looking back, it shows the events around the instant instead of the newest. */
 export class EventLog {
   constructor(host, controls, handlers) {
     this.host = host;
@@ -85,6 +83,8 @@ export class EventLog {
     this.nodeOf = () => undefined;
     this.transcript = new Transcript((path) => this.nodeOf(path)); // fed every event in order
     this.selectedRow = null;
+    this.past = null; // {events, seq}: the window around the instant shown, when looking back
+    this.frozen = false; // looking back: the newest events are kept, not drawn
     this.kinds = new KindFilter(controls.kinds, () => this.redraw());
     controls.text.addEventListener("input", () => this.redraw());
     controls.clear.addEventListener("click", () => this.reset());
@@ -94,7 +94,7 @@ export class EventLog {
       this.selectedRow?.classList.remove("selected");
       row.classList.add("selected");
       this.selectedRow = row;
-      this.handlers.select(row.dataset.select);
+      this.handlers.select(row.dataset.select, Number(row.dataset.seq));
     });
   }
 
@@ -138,7 +138,7 @@ export class EventLog {
     const line = this._describe(ev).line;
     return h("div", { class: `log-row kind-${ev.kind} level-${line.level}`, "data-select": selectionOf(ev), "data-seq": String(ev.seq) },
       h("span", { class: "seq", text: String(ev.seq) }),
-      h("span", { class: "time", text: clock(ev.t) }),
+      h("span", { class: "time", text: clockText(ev.t) }),
       h("span", { class: "kind", text: ev.kind }),
       h("span", { class: "path", title: ev.path }, h("bdi", { text: ev.path })),
       h("span", { class: "msg", text: line.text, title: ev.kind === "error" && ev.traceback ? ev.traceback : line.text }));
@@ -158,7 +158,7 @@ export class EventLog {
   }
 
   flush() {
-    if (!this.pending.length) return;
+    if (!this.pending.length || this.frozen) return;
     const events = this.pending;
     this.pending = [];
     const stick = this.stick;
@@ -173,10 +173,29 @@ export class EventLog {
     if (stick) this.host.scrollTop = this.host.scrollHeight;
   }
 
-  /** Draw again from the kept events (the filters or the events changed). */
+  /** Looking back: show `window` ({events, seq}, the events around the instant seq), the instant's
+   * row marked and scrolled to, later rows greyed; null: back to the newest events. */
+  showPast(window) {
+    const wasFrozen = this.frozen;
+    this.frozen = window !== null;
+    if (window === this.past && wasFrozen === this.frozen) return;
+    this.past = window;
+    this.redraw();
+  }
+
+  /** Looking back, before the window around the instant has come: keep the rows as they are. */
+  freeze() {
+    this.frozen = true;
+  }
+
+  /** Draw again from the kept events, or the window looked back at (the filters or the events changed). */
   redraw() {
     this.pending = [];
     this.needle = this.controls.text.value.trim().toLowerCase();
+    if (this.past) {
+      this._drawPast();
+      return;
+    }
     const matching = this.events.filter((ev) => this._matches(ev));
     this.shown = matching.length;
     const rows = matching.slice(-MAX_ROWS).map((ev) => this._row(ev));
@@ -185,6 +204,32 @@ export class EventLog {
     this._count();
     this.stick = true;
     this.host.scrollTop = this.host.scrollHeight;
+  }
+
+  _drawPast() {
+    const { events, seq } = this.past;
+    const transcript = new Transcript((path) => this.nodeOf(path)); // the window's own lines, in order
+    const rows = [];
+    let at = null;
+    for (const ev of events) {
+      const line = transcript.row(ev);
+      this.described.set(ev, { line, text: [...searchedWords(ev), line.text].join("\n").toLowerCase() });
+      if (!this._matches(ev)) continue;
+      const row = this._row(ev);
+      if (ev.seq > seq) row.classList.add("later");
+      else at = row;
+      rows.push(row);
+    }
+    at?.classList.add("at");
+    this.host.replaceChildren(...(rows.length ? rows : [h("p", { class: "empty", text: "No events here." })]));
+    this.selectedRow = null;
+    this.controls.count.textContent = `event ${seq}`;
+    this.stick = false;
+    if (at) { // centred in the log, without scrolling the page around it
+      const row = at.getBoundingClientRect();
+      const box = this.host.getBoundingClientRect();
+      this.host.scrollTop += row.top - box.top - box.height / 2;
+    }
   }
 
   _count() {

@@ -2,6 +2,7 @@
 // the one place that says what a machine's source (schema.js) lets this page do with it.
 
 import { api, ApiError } from "./api.js";
+import { readLink, writeLink } from "./deeplink.js";
 import { holdChange } from "./loop.js";
 import { banner } from "./notice.js";
 import { h } from "./dom.js";
@@ -85,14 +86,14 @@ export class Machines {
   _pick() {
     const name = this.store.name;
     if (name && this.list.some((m) => m.name === name)) return;
-    const wanted = decodeURIComponent((location.hash.match(/m=([^&]*)/) || [])[1] || "");
+    const wanted = readLink().machine;
     const pick = this.list.find((m) => m.name === wanted) || this.list.find((m) => m.running) || this.list[0];
     if (pick && pick.name !== name) this.handlers.open(pick.name);
   }
 
   /** The page now shows machine `name`: the address and the picker say so. */
   opened(name) {
-    history.replaceState(null, "", "#m=" + encodeURIComponent(name));
+    writeLink(name, readLink().machine === name ? readLink().seq : null);
     this.picker.value = name;
     this.checkEndings(); // the machine shown so far is one of the others now
   }

@@ -13,8 +13,20 @@ export class UserdataPanel {
     this.path = null;
     this.expanded = new Set();
     this.rendered = null; // the key of what was last drawn (path, userdata, changes, state)
+    this.history = null; // {key, items, cut}: the open history of one key
     picker.addEventListener("change", () => this.handlers.pick(picker.value));
     host.addEventListener("click", (e) => {
+      const historyButton = e.target.closest(".ud-history-btn");
+      if (historyButton) {
+        this.handlers.keyHistory(this.path, historyButton.dataset.key);
+        return;
+      }
+      const change = e.target.closest(".ud-key-change");
+      if (change) {
+        this.handlers.seek(Number(change.dataset.seq));
+        return;
+      }
+      if (e.target.closest(".ud-key-history")) return;
       const row = e.target.closest(".ud-row");
       if (!row) return;
       const key = row.dataset.key;
@@ -36,14 +48,28 @@ export class UserdataPanel {
     this.path = path;
     this.expanded.clear();
     this.rendered = null;
+    this.history = null;
     if (path) this.picker.value = path;
+  }
+
+  closeHistory() {
+    this.history = null;
+    this.rendered = null;
+    this.handlers.redraw();
+  }
+
+  /** Show the history of `key` (items of keyHistory(); `cut`: only the first page of the run was read). */
+  showHistory(key, items, cut) {
+    this.history = { key, items, cut };
+    this.rendered = null;
+    this.handlers.redraw();
   }
 
   update(status, node) {
     const entry = this.path ? status.containers[this.path] : null;
     const ud = entry ? entry.userdata : null;
     const changes = entry?.changes || {};
-    const key = JSON.stringify([this.path, ud, changes, entry?.running, entry?.outcome]);
+    const key = JSON.stringify([this.path, ud, changes, entry?.running, entry?.outcome, this.history]);
     if (this.rendered === key) return;
     this.rendered = key;
     if (!entry) {
@@ -69,11 +95,29 @@ export class UserdataPanel {
       if (value && typeof value === "object" && ("$repr" in value || "$truncated" in value)) valueCell.classList.add("repr");
       const change = Object.hasOwn(changes, key) ? changes[key] : null;
       if (change) valueCell.append(changeNote(change));
+      const historyButton = h("button", { type: "button", class: "ud-history-btn", "data-key": key, text: "history",
+        title: "every change of " + key + " in this run, with the state that made it" });
       body.append(h("tr", { class: "ud-row" + (change ? " changed" : ""), "data-key": key, title: open ? "" : "click to expand" },
-        h("th", { text: key }), valueCell));
+        h("th", { text: key }), valueCell, h("td", { class: "ud-actions" }, historyButton)));
     }
     table.append(body);
     this.host.replaceChildren(info, keys.length ? table : h("p", { class: "empty", text: "(no userdata)" }));
+    if (this.history) this.host.append(this._historyList());
+  }
+
+  _historyList() {
+    const { key, items, cut } = this.history;
+    const list = h("ol", { class: "ud-key-history" });
+    for (const item of items) {
+      list.append(h("li", { class: "ud-key-change", "data-seq": String(item.seq), title: "show event " + item.seq },
+        h("span", { class: "seq", text: String(item.seq) }), h("span", { class: "state", text: item.state }),
+        h("span", { class: "value", text: valueText(item.value, 80) })));
+    }
+    const close = h("button", { type: "button", text: "×", title: "close" });
+    close.addEventListener("click", () => this.closeHistory());
+    const title = h("div", { class: "ud-key-history-title" },
+      h("span", { text: `${key}: ${items.length} change${items.length === 1 ? "" : "s"}` + (cut ? " (the first page of the run)" : "") }), close);
+    return h("div", { class: "ud-key-history" }, title, items.length ? list : h("p", { class: "empty", text: "No change in this run." }));
   }
 }
 
@@ -81,4 +125,22 @@ export class UserdataPanel {
 function changeNote(change) {
   const text = Object.hasOwn(change, "old") ? "was " + valueText(change.old, 80) : "new key";
   return h("div", { class: "ud-change", text });
+}
+
+/** Every change of `key` in `events` (one container's start, transition and userdata events, in
+ * order): [{seq, t, state, value}], the state being the one active when it was written. */
+export function keyHistory(events, key) {
+  const items = [];
+  let active = [];
+  for (const ev of events) {
+    if (ev.kind === "start") {
+      active = ev.active;
+      if (Object.hasOwn(ev.userdata, key)) items.push({ seq: ev.seq, t: ev.t, state: "(start)", value: ev.userdata[key] });
+    } else if (ev.kind === "transition") {
+      active = ev.active;
+    } else if (ev.kind === "userdata" && Object.hasOwn(ev.changes, key)) {
+      items.push({ seq: ev.seq, t: ev.t, state: active.join(", ") || "?", value: ev.changes[key] });
+    }
+  }
+  return items;
 }

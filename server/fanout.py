@@ -32,6 +32,8 @@ from typing import Any, Callable
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 
+from .timeline import TimelineIndex
+
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
 MAX_BATCH = 1000           # events per frame at most
@@ -57,11 +59,13 @@ class Feed:
         self.clients: set[Client] = set()
         self.idle: set[Client] = set()  # clients whose sender waits for the next event
         self._snapshot: tuple[int, int, str] | None = None  # (id(status), last_seq, frame)
+        self.timeline = TimelineIndex()
 
     # In the machine's thread.
     def observe(self, event: dict) -> bool:
         """Apply, encode, hand over; True when the loop must be told."""
         encoded = dumps(event)
+        self.timeline.add(event)
         with self.lock:
             self.status.apply(event)
             handoff = self.handoff
@@ -94,6 +98,7 @@ class Feed:
         """An event from another process: update the Status, keep the event (encoded once), wake idle senders."""
         with self.lock:
             self.status.apply(event)
+        self.timeline.add(event)
         self.ring.append((event["seq"], dumps(event)))
         self.loop_seq = event["seq"]
         if self.idle:
@@ -101,6 +106,8 @@ class Feed:
 
     def reset(self, status: Status) -> None:
         """A new epoch (an ingesting process restarted, or sent a snapshot): clients start over."""
+        if status.last_seq < self.status.last_seq:  # restarted: its seqs begin again
+            self.timeline = TimelineIndex()
         with self.lock:
             self.status = status
         self.ring.clear()

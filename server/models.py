@@ -99,6 +99,48 @@ class MachineStatus(BaseModel):
                                           "serviced the pending preempt")
 
 
+class TimelinePoint(BaseModel):
+    seq: int
+    t: float = Field(description="wall clock, seconds")
+
+
+class TimelineRun(TimelinePoint):
+    run: str = Field(description="the run's id; seq and t: its first event")
+
+
+class TimelineTick(TimelinePoint):
+    kind: Literal["error", "preempt", "control", "run"]
+    text: str = Field(description="a short description, at most 200 characters")
+
+
+class Timeline(BaseModel):
+    """GET /api/machines/{name}/timeline (docs/api.md, "Timeline")."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{
+        "first": {"seq": 1, "t": 1700000000.0}, "last": {"seq": 7, "t": 1700000002.5}, "kept_from": 1,
+        "runs": [{"run": "3f9c2a1b7d4e", "seq": 1, "t": 1700000000.0}],
+        "bands": {"/SM_ROOT": [[1700000000.1, 1700000002.4, 2, "SUB"], [1700000002.4, 1700000002.5, 7, None]],
+                  "/SM_ROOT/SUB": [[1700000000.2, 1700000001.0, 3, "A"], [1700000001.0, 1700000002.3, 4, "B"],
+                                   [1700000002.3, 1700000002.5, 6, None]]},
+        "ticks": [{"seq": 1, "t": 1700000000.0, "kind": "run", "text": "run 3f9c2a1b7d4e"},
+                  {"seq": 5, "t": 1700000001.5, "kind": "preempt", "text": "preempt requested of /SM_ROOT"}],
+        "transitions": [[2, 1700000000.1], [3, 1700000000.2], [4, 1700000001.0], [6, 1700000002.3],
+                        [7, 1700000002.4]],
+        "coarse": False}]})
+
+    first: Optional[TimelinePoint] = Field(description="the machine's first event seen (null: none yet)")
+    last: Optional[TimelinePoint] = Field(description="its last event")
+    kept_from: int = Field(description="the seq from which the detail is whole (older detail was coalesced)")
+    runs: list[TimelineRun] = Field(description="the runs starting in the range, and the one under way at its start")
+    bands: dict[str, list[tuple[float, float, int, Optional[str]]]] = Field(
+        description="per container path: [t0, t1, seq of the band's first event, label]; label: the active child, "
+                    "'+' several (a Concurrence), '…' several states within one bucket, null not running")
+    ticks: list[TimelineTick] = Field(description="errors, preempt requests, controls, run starts (the newest 5000)")
+    transitions: list[tuple[int, float]] = Field(description="[seq, t] of every start/transition/terminate in the "
+                                                 "range (at most 5000, evenly spread when there are more)")
+    coarse: bool = Field(description="transitions were thinned, or the range reaches into coalesced detail")
+
+
 class PreemptRequest(BaseModel):
     model_config = ConfigDict(extra="forbid")
 

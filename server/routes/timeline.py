@@ -1,0 +1,37 @@
+"""A machine's timeline (server/timeline.py): its span, bands, ticks and transition seqs, at a zoom."""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Optional
+
+from fastapi import APIRouter, HTTPException, Query
+from fastapi.concurrency import run_in_threadpool
+from fastapi.responses import Response
+
+from fsm.observation.encoding import dumps
+
+from .. import models
+from .deps import AUTH, ERRORS, Machine
+
+router = APIRouter(dependencies=AUTH, tags=["machines"])
+
+MAX_BUCKETS = 10_000
+
+
+@router.get("/api/machines/{name}/timeline", response_model=models.Timeline, responses=ERRORS)
+async def timeline(entry: Machine,
+                   since_t: Annotated[Optional[float], Query(description="from this time (default: the first "
+                                                             "event's)")] = None,
+                   until_t: Annotated[Optional[float], Query(description="to this time (default: the last "
+                                                             "event's)")] = None,
+                   buckets: Annotated[int, Query(ge=1, le=MAX_BUCKETS, description="bands per container, about; "
+                                                 "states shorter than a bucket are drawn as one '…' band")] = 1000,
+                   ) -> Response:
+    for field, value in (("since_t", since_t), ("until_t", until_t)):
+        if value is not None and not math.isfinite(value):
+            raise HTTPException(422, "%s must be a finite number of seconds, not %s" % (field, value))
+    if since_t is not None and until_t is not None and since_t > until_t:
+        raise HTTPException(422, "since_t (%r) is after until_t (%r)" % (since_t, until_t))
+    answer = await run_in_threadpool(entry.timeline.answer, since_t, until_t, buckets)
+    return Response(dumps(answer), media_type="application/json")

@@ -9,7 +9,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import os
-from typing import Any, AsyncIterator
+from typing import Any, AsyncIterator, Callable
 
 from fastapi import FastAPI, Request
 from fastapi.exceptions import RequestValidationError
@@ -21,13 +21,15 @@ from swagger_ui_bundle import swagger_ui_path
 from .local_control import ControlError
 from .hub import Hub
 from .middleware import SecurityMiddleware
-from .routes import control, ingest, machines, pages, stream, timeline
+from .routes import control, ingest, machines, pages, scene, stream, timeline
 from .settings import Settings
 
 
 def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int | None = None,
-               title: str = "fsmscope", scene_url: str | None = None) -> FastAPI:
-    """The dashboard's app; ``scene_url``: a 3D view served beside it (the sim demo's viser), or None."""
+               title: str = "fsmscope", scene_url: str | None = None,
+               show_pose: Callable[[dict | None], None] | None = None) -> FastAPI:
+    """The dashboard's app; ``scene_url``: a 3D view served beside it (the sim demo's viser), or None;
+    ``show_pose``: what draws a pose's fields in that view (None: back to live), for POST /api/scene/pose."""
 
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
@@ -39,12 +41,13 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
                description="Live view and control of fsm state machines (docs/api.md).")
     app.state.settings = Settings(token=token, host=host, port=port, scene_url=scene_url)
     app.state.hub = hub
+    app.state.show_pose = show_pose
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(Exception, _unexpected_error)
     app.add_exception_handler(ControlError, _control_error)
     app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")  # for pages.docs
-    for module in (pages, machines, timeline, control, stream, ingest):
+    for module in (pages, machines, timeline, control, scene, stream, ingest):
         app.include_router(module.router)
     root = pages.static_dir()
     if root and os.path.isdir(root):

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import socket
 import threading
-from typing import Any
+from typing import Any, Callable
 
 from .auth import check_bind, new_token
 from .hub import Hub
@@ -55,7 +55,8 @@ class ServerThread:
     """A hub's app served by uvicorn in a background thread on a socket bound before it starts."""
 
     def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
-                 log_level: str = "warning", scene_url: str | None = None) -> None:
+                 log_level: str = "warning", scene_url: str | None = None,
+                 show_pose: Callable[[dict | None], None] | None = None) -> None:
         from .app import create_app
         import uvicorn
 
@@ -65,7 +66,8 @@ class ServerThread:
         self.host = host
         self.sock = bind_socket(host, port)
         self.port = self.sock.getsockname()[1]
-        self.app = create_app(self.hub, self.token, host=host, port=self.port, scene_url=scene_url)
+        self.app = create_app(self.hub, self.token, host=host, port=self.port, scene_url=scene_url,
+                              show_pose=show_pose)
         self.server = uvicorn.Server(uvicorn_config(self.app, log_level))
         self._thread: threading.Thread | None = None
 

@@ -24,6 +24,20 @@ class Scene(BaseModel):
     url: str | None = None
 
 
+class ScenePoseRequest(BaseModel):
+    """POST /api/scene/pose: a pose event's fields to show in the 3D view, or null for the live robot."""
+    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
+        {"pose": {"joints": {"j1": 0.0, "j2": 0.0309, "finger_left": 0.04},
+                  "bodies": {"cube": [0.4, 0.15, 0.42, 1.0, 0.0, 0.0, 0.0]}}}, {"pose": None}]})
+
+    pose: Optional[dict[str, JsonValue]] = Field(description="{joints: {name: position}, bodies?: {name: "
+                                                 "[x, y, z, qw, qx, qy, qz]}} (docs/events.md, kind pose), or null")
+
+
+class ScenePoseShown(BaseModel):
+    live: bool = Field(description="the 3D view shows the live robot again (the request's pose was null)")
+
+
 class MachineInfo(BaseModel):
     name: str
     running: bool

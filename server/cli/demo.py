@@ -57,6 +57,7 @@ def main(args: argparse.Namespace) -> int:
     import fsm
     from fsm.logfiles.recorder import Recorder
     from sim.demo import SimDemo
+    from sim.pose import PoseTap
 
     if not args.verbose:
         _quiet_loggers()
@@ -65,13 +66,23 @@ def main(args: argparse.Namespace) -> int:
     demo = SimDemo(seed=args.seed, fast=args.fast, scene=not args.headless)
     machine = demo.build_machine()
     recorder = Recorder(record_path)
-    fsm.attach(machine, recorder, name=MACHINE_NAME)
+    rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
+
+    def record_pose(fields: dict) -> bool:
+        if rep.run is None:  # not started yet: a log opens with the machine's structure
+            return False
+        rep.emit("pose", rep.root_path, fields)
+        return True
+
+    tap = PoseTap(demo.world, record_pose)
     resume = threading.Event()
     hold = threading.Event()
     server = None
     try:
         if not args.headless:
-            server = start_server(args, scene_url=demo.scene.url if demo.scene is not None else None)
+            scene = demo.scene
+            server = start_server(args, scene_url=scene.url if scene is not None else None,
+                                  show_pose=scene.show_pose if scene is not None else None)
             server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set)
             print("fsmscope demo: open %s" % server.url, flush=True)
         print("fsmscope demo: recording to %s" % record_path, flush=True)
@@ -98,11 +109,13 @@ def main(args: argparse.Namespace) -> int:
             failure.append(exc)
 
     worker = threading.Thread(target=work, name="sim-episodes", daemon=True)
+    tap.start()
     worker.start()
     try:
         while worker.is_alive():
             worker.join(0.2)
     finally:
+        tap.stop()
         demo.close()
         worker.join(5.0)
         if server is not None:

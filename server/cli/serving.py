@@ -29,7 +29,7 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
 
 def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
     """The dashboard's server on ``--host/--port/--token``, started; ``options`` go to ``ServerThread``
-    (``scene_url``). Raises CannotServe."""
+    (``scene_url``, ``show_pose``). Raises CannotServe."""
     from ..http_server import ServerThread
 
     try:

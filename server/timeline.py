@@ -103,40 +103,37 @@ class TimelineIndex:
         self._clock = float("-inf")  # the latest t marked: marks never go back in time (a wall clock may)
 
     def add(self, event: dict) -> None:
-        """One event of the machine, in order."""
+        """One event of the machine, in order. A mark is the hot path (every step of a running
+        machine), written out here rather than split into calls: each call costs the machine."""
         if self.last is None:
             self.first = (event["seq"], event["t"])
         self.last = event
         kind = event["kind"]
-        if kind in _MARKS:
-            self._mark(event, kind)
-        elif kind in _TICKS:
-            text = _tick_text(event, kind)
-            if text is not None:
-                self._tick(event["seq"], self._now(event["t"]), kind, text)
-        elif kind == "structure":
-            self._check_run(event)
-
-    def _now(self, t: float) -> float:
-        if t < self._clock:
-            return self._clock
-        self._clock = t
-        return t
-
-    def _mark(self, event: dict, kind: str) -> None:
+        if kind not in _MARKS:
+            if kind in _TICKS:
+                text = _tick_text(event, kind)
+                if text is not None:
+                    self._tick(event["seq"], self._now(event["t"]), kind, text)
+            elif kind == "structure":
+                self._check_run(event)
+            return
         if kind == "start":
             self._check_run(event)
-        seq, t = event["seq"], self._now(event["t"])
-        path = event["path"]
-        track = self._tracks.get(path)
+        t = event["t"]
+        if t < self._clock:
+            t = self._clock
+        else:
+            self._clock = t
+        track = self._tracks.get(event["path"])
         if track is None:
-            track = self._tracks[path] = _Track()
+            track = self._tracks[event["path"]] = _Track()
         if kind == "terminate":
             label = None
         else:
             active = event["active"]
             label = active[0] if len(active) == 1 else (SEVERAL if active else None)
         seqs, ts = self._steps
+        seq = event["seq"]
         seqs.append(seq)
         ts.append(t)
         labels = track.label
@@ -146,6 +143,13 @@ class TimelineIndex:
             labels.append(label)
         if len(seqs) > MAX_MARKS:
             self._coalesce()
+
+    def _now(self, t: float) -> float:
+        """``t``, or the latest time marked when the wall clock went back."""
+        if t < self._clock:
+            return self._clock
+        self._clock = t
+        return t
 
     def _check_run(self, event: dict) -> None:
         run = event.get("run")

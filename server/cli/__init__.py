@@ -21,7 +21,7 @@ import argparse
 import sys
 from typing import Protocol
 
-from . import demo, replay, run, serve
+from . import demo, export, replay, run, serve
 from .serving import CannotServe
 
 
@@ -34,7 +34,7 @@ class Subcommand(Protocol):
     def main(self, args: argparse.Namespace) -> int: ...
 
 
-SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "demo": demo}
+SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "export": export, "demo": demo}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,0 +1,45 @@
+"""``fsmscope export LOG --html OUT.html``: a recorded run as one HTML file that opens from disk with
+no server and no network (server/export_html.py)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+
+HELP = "write a recorded run as one HTML file that shows it in the dashboard, from disk, with no server"
+PASSES_ARGUMENTS_ON = False
+EXIT_UNREADABLE = 2  # the log cannot be read or exported
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    from ..export_html import MAX_MB
+
+    parser.add_argument("log", metavar="RUN.jsonl", help="a log written by the recorder")
+    parser.add_argument("--html", metavar="OUT.html", required=True,
+                        help="the file to write: open it in a browser (file://); it needs nothing else")
+    parser.add_argument("--max-mb", type=float, default=MAX_MB,
+                        help="refuse a log larger than this many megabytes (default %(default)s): the whole "
+                             "run goes into the page, which the browser holds in memory")
+
+
+def main(args: argparse.Namespace) -> int:
+    from fsm.logfiles.log_reader import LogError
+
+    from ..export_html import ExportError, export_html
+
+    def skipped(problem: object) -> None:
+        print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
+
+    try:
+        text = export_html(args.log, max_bytes=int(args.max_mb * 2**20), on_problem=skipped)
+    except (ExportError, LogError) as exc:
+        print("fsmscope export: %s" % exc, file=sys.stderr)
+        return EXIT_UNREADABLE
+    partial = args.html + ".partial"
+    with open(partial, "w", encoding="utf-8") as handle:
+        handle.write(text)
+    os.replace(partial, args.html)
+    print("fsmscope: wrote %s (%.1f MB); open it in a browser" % (args.html, len(text.encode()) / 2**20),
+          file=sys.stderr)
+    return 0

@@ -40,6 +40,7 @@ MAX_BATCH = 1000           # events per frame at most
 HISTORY = 5000             # events of the current run a new client is sent for its log, at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
 HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
+KEYFRAME_EVERY = 1000      # a copy of the Status every this many events, for the status at a seq the ring holds
 
 _FRAME_HEAD = b'{"type":"events","events":['
 _FRAME_TAIL = b"]}"
@@ -55,6 +56,10 @@ class Feed:
         self.dropped = 0  # events dropped from the hand-off since the loop last drained it
         self.queued = False  # the feed waits in the fan-out's ready queue
         self.ring: collections.deque[tuple[int, bytes]] = collections.deque(maxlen=RING_SIZE)
+        # (seq, Status.to_dict() after it), taken as events are applied; as many as span the ring (server/history.py)
+        self.keyframes: collections.deque[tuple[int, dict]] = collections.deque(
+            maxlen=RING_SIZE // KEYFRAME_EVERY + 2)
+        self.next_keyframe = 0  # the first event applied takes one of the state before it
         self.loop_seq = 0  # the seq of the newest event the loop has taken (the ring's end, gaps or not)
         self.clients: set[Client] = set()
         self.idle: set[Client] = set()  # clients whose sender waits for the next event
@@ -67,6 +72,8 @@ class Feed:
         encoded = dumps(event)
         self.timeline.add(event)
         with self.lock:
+            if event["seq"] >= self.next_keyframe:
+                self.keyframe()
             self.status.apply(event)
             handoff = self.handoff
             if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
@@ -97,6 +104,8 @@ class Feed:
     def apply(self, event: dict) -> None:
         """An event from another process: update the Status, keep the event (encoded once), wake idle senders."""
         with self.lock:
+            if event["seq"] >= self.next_keyframe:
+                self.keyframe()
             self.status.apply(event)
         self.timeline.add(event)
         self.ring.append((event["seq"], dumps(event)))
@@ -110,11 +119,19 @@ class Feed:
             self.timeline = TimelineIndex()
         with self.lock:
             self.status = status
+            self.keyframes.clear()
+            self.keyframe()
         self.ring.clear()
         self.loop_seq = status.last_seq
         for client in self.clients:
             client.need_snapshot = True
         self.wake_idle()
+
+    def keyframe(self) -> None:
+        """Keep a copy of the Status as it is now (holding the lock), for the status at a past seq."""
+        status = self.status
+        self.keyframes.append((status.last_seq, status.to_dict()))
+        self.next_keyframe = status.last_seq + KEYFRAME_EVERY
 
     def wake_idle(self) -> None:
         idle = self.idle

@@ -9,6 +9,9 @@
 * ``seek(path, machine, seq)`` rebuilds one machine's state at one event from the nearest
   snapshot (found through the ``.idx`` sidecar), or by scanning when the index is missing
   or stale.
+* ``complete_lines(handle, offset)`` yields the lines from a byte offset on, with their offsets,
+  for readers that index a log themselves (server/history.py); a last line still being written
+  is left for later.
 """
 
 from __future__ import annotations
@@ -197,6 +200,20 @@ def follow(path: str | os.PathLike, on_problem: Callable[[Problem], None] | None
 
 
 # Seeking.
+
+def complete_lines(handle: Any, offset: int = 0) -> Iterator[tuple[int, bytes]]:
+    """(its offset, the line) for each complete line of ``handle`` from ``offset`` (a line's start) on.
+
+    A last line without its newline is left out silently: its writer may be mid-write, and it
+    is read whole on a later call.
+    """
+    handle.seek(offset)
+    for raw in handle:
+        if raw[-1:] != b"\n":
+            return
+        yield offset, raw
+        offset += len(raw)
+
 
 def read_index(path: str | os.PathLike) -> list[dict]:
     """The snapshot index beside a log ([] when missing; unreadable lines are ignored)."""

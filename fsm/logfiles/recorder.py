@@ -7,7 +7,7 @@ terminates, or when ``flush_bytes`` bytes wait). ``close()`` writes what is left
 and fsyncs. Nothing is ever fsynced per event.
 
 Every ``snapshot_every`` events of a machine the recorder writes a ``snapshot`` event (the
-state rebuilt by ``fsm.observation.status.Status``) and a line ``{"machine", "seq", "offset"}`` in the
+state rebuilt by ``fsm.observation.status.Status``) and a line ``{"machine", "seq", "t", "offset"}`` in the
 ``<path>.idx`` sidecar, so a reader can rebuild the state at any event without reading the
 log from its start (``fsm.logfiles.log_reader.seek``).
 
@@ -121,7 +121,8 @@ class Recorder:
         event = schema.event(status.last_seq, time.time(), status.run, status.machine, "snapshot",
                              status.root_path, {"status": status.to_dict()})
         offset = self._taken + len(self._buf)
-        self._index_chunks.append(_dumps_line({"machine": status.machine, "seq": status.last_seq, "offset": offset}))
+        self._index_chunks.append(_dumps_line({"machine": status.machine, "seq": status.last_seq, "t": status.last_t,
+                                               "offset": offset}))
         self._buf += _dumps_line(event)
         self.snapshots += 1
 

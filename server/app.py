@@ -21,7 +21,7 @@ from swagger_ui_bundle import swagger_ui_path
 from .local_control import ControlError
 from .hub import Hub
 from .middleware import SecurityMiddleware
-from .routes import control, ingest, machines, pages, scene, stream, timeline
+from .routes import control, history, ingest, machines, pages, scene, stream, timeline
 from .settings import Settings
 
 
@@ -47,7 +47,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     app.add_exception_handler(Exception, _unexpected_error)
     app.add_exception_handler(ControlError, _control_error)
     app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")  # for pages.docs
-    for module in (pages, machines, timeline, control, scene, stream, ingest):
+    for module in (pages, machines, history, timeline, control, scene, stream, ingest):
         app.include_router(module.router)
     root = pages.static_dir()
     if root and os.path.isdir(root):

@@ -21,6 +21,7 @@ from fsm.observation.status import Status
 
 from .local_control import MachineHandle
 from .fanout import Fanout, Feed, Observer
+from .history import History, LogHistory
 
 
 def structure_hash(root: dict | None) -> str:
@@ -39,6 +40,7 @@ class MachineEntry(Feed):
         self.handle: MachineHandle | None = None  # local machines only
         self.reporter: introspection.Reporter | None = None
         self.observer: Observer | None = None
+        self.history = History(self)  # its past (server/history.py): the ring, and a recording when it has one
         self._structure_id: int | None = None
         self._structure_hash = ""
         self._n_states = 0
@@ -97,11 +99,12 @@ class Hub:
 
     def add_local(self, machine: Any, name: str | None = None, path: str = introspection.DEFAULT_ROOT_PATH,
                   can_start: bool = True, starter: Callable[[], Any] | None = None,
-                  holder: Callable[[], Any] | None = None) -> MachineEntry:
+                  holder: Callable[[], Any] | None = None, recording: str | None = None) -> MachineEntry:
         """Observe ``machine`` (any thread). A machine already observed keeps its reporter's name.
 
         ``starter``: what POST .../start calls (in a worker thread) instead of executing the machine
         in a new thread, for a host that runs the machine in its own loop (see control.MachineHandle).
+        ``recording``: the log a Recorder writes its events to, where its history older than the ring is read.
         """
         rep = introspection.reporter_of(machine)
         with self._lock:
@@ -118,6 +121,8 @@ class Hub:
                                         {"root": rep.structure()}))
         entry.loop_seq = rep.last_seq
         entry.observer = Observer(entry, self.fanout)
+        if recording is not None:
+            entry.history = History(entry, LogHistory(recording, entry.name))
         with self._lock:
             if entry.name in self._machines:
                 raise ValueError("a machine named %r is already served" % entry.name)

@@ -80,12 +80,37 @@ class StructureNode(BaseModel):
     transitions: Optional[list[Transition]] = None
 
 
+class LastTransition(BaseModel):
+    model_config = ConfigDict(populate_by_name=True)
+
+    from_: str = Field(alias="from")
+    outcome: Optional[str] = None
+    to: Optional[str] = None
+    seq: int = Field(description="the event that made it")
+
+
+class KeyChange(BaseModel):
+    old: Optional[JsonValue] = Field(default=None, description="absent: the key is new")
+    new: JsonValue
+
+
 class ContainerStatus(BaseModel):
     active: list[str]
     initial: list[str]
     userdata: dict[str, JsonValue]
     running: bool
     outcome: Optional[str] = None
+    last: Optional[LastTransition] = Field(default=None, description="its last transition in this run")
+    changes: dict[str, KeyChange] = Field(default_factory=dict, description="the userdata keys its last "
+                                          "transition wrote: {key: {old?, new}}")
+    written: bool = Field(default=False, description="userdata was written since its last transition")
+
+
+class Pose(BaseModel):
+    seq: int
+    t: float
+    joints: dict[str, float]
+    bodies: dict[str, list[float]] = Field(default_factory=dict, description="name: [x, y, z, qw, qx, qy, qz]")
 
 
 class PendingPreempt(BaseModel):
@@ -96,7 +121,16 @@ class PendingPreempt(BaseModel):
 
 
 class MachineStatus(BaseModel):
-    """``fsm.observation.status.Status.to_dict()`` without ``structure``."""
+    """``fsm.observation.status.Status.to_dict()`` without ``structure``: now, or after event ``seq``."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{
+        "machine": "two", "run": "3f9c2a1b7d4e", "root_path": "/SM_ROOT",
+        "containers": {"/SM_ROOT": {"active": ["BAR"], "initial": ["FOO"], "userdata": {"visits": ["FOO"]},
+                                    "running": True, "outcome": None,
+                                    "last": {"from": "FOO", "outcome": "go", "to": "BAR", "seq": 4},
+                                    "changes": {"visits": {"old": [], "new": ["FOO"]}}, "written": False}},
+        "running": True, "outcome": None, "error": None, "last_seq": 4, "last_t": 1700000000.25, "run_seq": 1,
+        "preempt": None, "pose": None, "preempt_waiting_on": []}]})
 
     machine: str
     run: Optional[str] = None
@@ -109,8 +143,27 @@ class MachineStatus(BaseModel):
     last_t: Optional[float] = None
     run_seq: int = Field(default=0, description="the seq of the current run's first event")
     preempt: Optional[PendingPreempt] = Field(default=None, description="a preempt requested and not over yet")
+    pose: Optional[Pose] = Field(default=None, description="the robot's last recorded pose (a pose event)")
     preempt_waiting_on: list[str] = Field(default_factory=list, description="the active states that have not "
                                           "serviced the pending preempt")
+
+
+class HistoryPage(BaseModel):
+    """GET /api/machines/{name}/history (docs/api.md, "Time travel")."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{
+        "events": [{"v": 1, "seq": 3, "t": 1700000000.2, "run": "3f9c2a1b7d4e", "machine": "two",
+                    "kind": "userdata", "path": "/SM_ROOT", "changes": {"visits": ["FOO"]}},
+                   {"v": 1, "seq": 4, "t": 1700000000.25, "run": "3f9c2a1b7d4e", "machine": "two",
+                    "kind": "transition", "path": "/SM_ROOT", "from": "FOO", "outcome": "go", "to": "BAR",
+                    "active": ["BAR"]}],
+        "first_seq": 1, "last_seq": 7, "more": True, "next": 5}]})
+
+    events: list[dict[str, JsonValue]] = Field(description="events of docs/events.md, oldest first (no snapshots)")
+    first_seq: Optional[int] = Field(description="the oldest seq served for this machine (older: 410)")
+    last_seq: Optional[int] = Field(description="its newest event")
+    more: bool = Field(description="the range holds more events than this page (or the page stopped scanning)")
+    next: Optional[int] = Field(description="since (order=asc) or until (order=desc) of the next page; null: none")
 
 
 class TimelinePoint(BaseModel):

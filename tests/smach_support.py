@@ -153,3 +153,24 @@ def one_state_machine(label: str, state: smach.State) -> smach.StateMachine:
     with sm:
         smach.StateMachine.add(label, state, {"done": "done"})
     return sm
+
+
+def counting_machine(rounds: int) -> smach.StateMachine:
+    """SM_ROOT: COUNT (n += 1) -> SUB (A -> B, each writing `trail`) -> COUNT ..., 'done' after ``rounds``
+    (about 7 events a round: a long run of two levels with userdata, for history and recording tests)."""
+    def count(ud: Any) -> str:
+        ud.n = ud.n + 1
+        return "again" if ud.n <= rounds else "enough"
+
+    def mark(label: str) -> Out:
+        def write(ud: Any) -> str:
+            ud.trail = label
+            return "done"
+        return Out(write, output_keys=["trail"])
+
+    sub = machine(["done"], [("A", mark("A"), {"done": "B"}), ("B", mark("B"), {"done": "done"})])
+    sm = machine(["done"], [("COUNT", Out(count, outcomes=["again", "enough"], input_keys=["n"], output_keys=["n"]),
+                             {"again": "SUB", "enough": "done"}),
+                            ("SUB", sub, {"done": "COUNT"})])
+    sm.userdata.n = 0
+    return sm

@@ -83,7 +83,8 @@ def main(args: argparse.Namespace) -> int:
             scene = demo.scene
             server = start_server(args, scene_url=scene.url if scene is not None else None,
                                   show_pose=scene.show_pose if scene is not None else None)
-            server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set)
+            server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set,
+                                 recording=record_path)
             print("fsmscope demo: open %s" % server.url, flush=True)
         print("fsmscope demo: recording to %s" % record_path, flush=True)
     except BaseException:

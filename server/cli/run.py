@@ -42,7 +42,8 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner) -> int:
     signal (Ctrl-C, SIGTERM) ended the script: one signal stops everything."""
     srv = start_server(args)
     hub = srv.hub
-    runner.on_machine.append(lambda name, container: hub.add_local(container, name=name, can_start=True))
+    runner.on_machine.append(lambda name, container: hub.add_local(container, name=name, can_start=True,
+                                                                   recording=runner.record_path))
     runner.keep_open = True  # runs started from the dashboard after the script ends are recorded too
     print("fsmscope: dashboard at %s" % srv.url, file=sys.stderr, flush=True)
     try:

@@ -1,4 +1,4 @@
-"""What the dashboard reads about machines: the list, a machine's structure and status, its graph."""
+"""What the dashboard reads about machines: the list, a machine's structure, its graph (its status: routes/history.py)."""
 
 from __future__ import annotations
 
@@ -36,13 +36,6 @@ async def structure(entry: Machine) -> Any:
     if entry.status.structure is None:
         raise HTTPException(404, "machine %r has no structure yet" % entry.name)
     return entry.status.structure
-
-
-@router.get("/api/machines/{name}/status", response_model=models.MachineStatus, responses=ERRORS)
-async def status(entry: Machine) -> Any:
-    data = entry.status_dict()
-    data.pop("structure", None)
-    return data
 
 
 @router.get("/api/machines/{name}/graph.svg",

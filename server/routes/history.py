@@ -1,0 +1,87 @@
+"""A machine's status now or at any past event, and its events page by page (server/history.py).
+
+Both read what machine threads handed over first (``Fanout.flush``), copy what memory holds on the
+loop (``History.view``) and do the rest, file reads included, in the thread pool.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Any, Callable, Literal, Optional
+
+from fastapi import APIRouter, HTTPException, Query
+from fastapi.concurrency import run_in_threadpool
+from fastapi.responses import Response
+
+from fsm.observation.encoding import dumps
+from fsm.observation.schema import KINDS
+
+from .. import models
+from ..history import DEFAULT_LIMIT, MAX_LIMIT, HistoryError, HistoryView
+from .deps import AUTH, ERRORS, HubDep, Machine
+
+router = APIRouter(dependencies=AUTH, tags=["machines"])
+
+PAST_ERRORS = {**ERRORS,
+               410: {"model": models.Error, "description": "older than the history kept (the message says how far "
+                     "back it reaches)"},
+               416: {"model": models.Error, "description": "beyond the machine's last event"}}
+SEQ_EXAMPLES = {"an event": {"value": 1200, "description": "the status right after event 1200"}}
+T_EXAMPLES = {"an instant": {"value": 1700000000.5, "description": "the status after the last event at or "
+                             "before this time"}}
+
+
+async def answer(hub: HubDep, entry: Machine, question: Callable[[HistoryView], Any]) -> Any:
+    """``question(view)`` on a view of the machine's history, in the thread pool; its HistoryError
+    as the HTTP error it names."""
+    hub.fanout.flush()
+    view = entry.history.view()
+    try:
+        return await run_in_threadpool(question, view)
+    except HistoryError as exc:
+        raise HTTPException(exc.status, exc.message) from None
+
+
+@router.get("/api/machines/{name}/status", response_model=models.MachineStatus, responses=PAST_ERRORS)
+async def status(hub: HubDep, entry: Machine,
+                 seq: Annotated[Optional[int], Query(ge=0, description="the status right after this event",
+                                                     openapi_examples=SEQ_EXAMPLES)] = None,
+                 t: Annotated[Optional[float], Query(description="the status after the last event at or before "
+                                                     "this time (seconds)", openapi_examples=T_EXAMPLES)] = None,
+                 ) -> Response:
+    """The machine's status now, or after event ``seq``, or at time ``t`` (one of them at most)."""
+    if seq is not None and t is not None:
+        raise HTTPException(422, "give seq or t, not both")
+    if t is not None and not math.isfinite(t):
+        raise HTTPException(422, "t must be a finite number of seconds, not %s" % t)
+    if seq is None and t is None:
+        data = entry.status_dict()
+        data.pop("structure", None)
+    else:
+        data = await answer(hub, entry, lambda view: view.status_at(seq, t))
+    return Response(dumps(data), media_type="application/json")
+
+
+@router.get("/api/machines/{name}/history", response_model=models.HistoryPage, responses=PAST_ERRORS)
+async def history(hub: HubDep, entry: Machine,
+                  since: Annotated[Optional[int], Query(ge=0, description="from this seq (default: the oldest "
+                                                        "kept)")] = None,
+                  until: Annotated[Optional[int], Query(ge=0, description="to this seq (default: the last)")] = None,
+                  limit: Annotated[int, Query(ge=1, le=MAX_LIMIT, description="events at most")] = DEFAULT_LIMIT,
+                  kinds: Annotated[Optional[str], Query(max_length=1000, description="only these kinds, "
+                                                        "comma-separated", examples=["transition,error"])] = None,
+                  path: Annotated[Optional[str], Query(max_length=2000, description="only events of this path "
+                                                       "(exact)")] = None,
+                  order: Annotated[Literal["asc", "desc"], Query(description="desc: the newest `limit` of the "
+                                                                 "range (still oldest first), to page backwards")
+                                   ] = "asc",
+                  ) -> Response:
+    """Events with since <= seq <= until, oldest first, a page at a time."""
+    wanted = None
+    if kinds is not None:
+        wanted = {kind.strip() for kind in kinds.split(",") if kind.strip()}
+        unknown = sorted(wanted - set(KINDS))
+        if unknown:
+            raise HTTPException(422, "kinds: %r is not an event kind (%s)" % (unknown[0][:50], ", ".join(KINDS)))
+    page = await answer(hub, entry, lambda view: view.page(since, until, limit, wanted, path, order))
+    return Response(page.to_json(), media_type="application/json")

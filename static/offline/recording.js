@@ -69,6 +69,7 @@ class RecordedMachine {
     return {
       name: this.name, running: end.running, outcome: end.outcome, last_seq: this.lastSeq, root_path: end.root_path,
       can_start: false, can_hold: false, held: false, source: "replay", connected: null, rejected: 0,
+      replay: { speed: 1 }, // the page's play speed when it opens
     };
   }
 
@@ -82,7 +83,9 @@ class RecordedMachine {
       if (seq < this.firstSeq) throw new ApiError(410, `history reaches back to seq ${this.firstSeq}`);
       index = countAtMost(this.seqs, seq) - 1;
     } else if (given(at.t)) {
-      index = Math.max(0, countAtMost(this.times, finite(at.t, "t")) - 1);
+      const t = finite(at.t, "t");
+      index = countAtMost(this.times, t) - 1;
+      if (index < 0) throw new ApiError(410, `t ${t} is before what history keeps: it reaches back to seq ${this.firstSeq}`);
     }
     return this._statusAfter(index);
   }
@@ -104,26 +107,28 @@ class RecordedMachine {
     if (limit < 1 || limit > LIMIT_MAX) throw new ApiError(422, `limit must be between 1 and ${LIMIT_MAX}`);
     const since = given(params.since) ? integer(params.since, "since") : this.firstSeq;
     const until = given(params.until) ? integer(params.until, "until") : this.lastSeq;
+    if (given(params.since) && given(params.until) && since > until) {
+      throw new ApiError(422, `since (${since}) is after until (${until})`);
+    }
+    if (until < this.firstSeq) throw new ApiError(410, `history reaches back to seq ${this.firstSeq}`);
     const kinds = given(params.kinds) ? new Set([].concat(params.kinds).join(",").split(",")) : null;
     const path = given(params.path) ? params.path : null;
     const wanted = (ev) => (!kinds || kinds.has(ev.kind)) && (path === null || ev.path === path);
-    const lo = since === 0 ? 0 : countAtMost(this.seqs, since - 1);
+    const lo = countAtMost(this.seqs, since - 1);
     const hi = countAtMost(this.seqs, until);
     const desc = params.order === "desc";
     const events = [];
-    let more = false;
+    let next = null; // the first match beyond the limit: the since (or, desc, the until) of the next page
     for (let i = desc ? hi - 1 : lo; desc ? i >= lo : i < hi; i += desc ? -1 : 1) {
       if (!wanted(this.events[i])) continue;
       if (events.length === limit) {
-        more = true;
+        next = this.events[i].seq;
         break;
       }
       events.push(this.events[i]);
     }
     if (desc) events.reverse();
-    let next = null;
-    if (more) next = desc ? events[0].seq - 1 : events[events.length - 1].seq + 1;
-    return { events, first_seq: this.firstSeq, last_seq: this.lastSeq, more, next };
+    return { events, first_seq: this.firstSeq, last_seq: this.lastSeq, more: next !== null, next };
   }
 
   /** GET .../timeline: the whole run's, as the export computed it, sliced to [since_t, until_t]. */
@@ -135,6 +140,7 @@ class RecordedMachine {
     if (!given(params.since_t) && !given(params.until_t)) return whole;
     const lo = given(params.since_t) ? finite(params.since_t, "since_t") : whole.first.t;
     const hi = given(params.until_t) ? finite(params.until_t, "until_t") : whole.last.t;
+    if (lo > hi) throw new ApiError(422, `since_t (${lo}) is after until_t (${hi})`);
     const within = (t) => lo <= t && t <= hi;
     const bands = {};
     for (const [path, list] of Object.entries(whole.bands)) {

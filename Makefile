@@ -36,6 +36,7 @@ test: install
 bench: install
 	$(PY) bench/runtime.py
 	$(PY) bench/replay.py
+	$(PY) bench/timetravel.py
 	$(PY) bench/server.py
 	$(PY) bench/graph.py
 	$(PY) bench/sim.py

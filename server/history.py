@@ -183,13 +183,17 @@ class LogHistory:
         for j in range(k, -1, -1):
             start = marks[j - 1].offset if j else 0
             end = marks[j].offset if j < len(marks) else None
-            found = []
-            for offset, seq, raw, event in self._valid(start, since):
-                if seq > until or (end is not None and offset >= end):
+            found = []  # validated only when taken, newest first: a page takes the newest `limit` of them
+            for offset, seq, raw, event in self._lines(start):
+                if end is not None and offset >= end:
                     break
-                if event["kind"] != "snapshot":
-                    found.append((seq, raw[:-1], event))
-            yield from reversed(found)
+                if seq > until and validate(event) is None:
+                    break
+                if since <= seq <= until:
+                    found.append((seq, raw, event))
+            for seq, raw, event in reversed(found):
+                if event["kind"] != "snapshot" and validate(event) is None:
+                    yield seq, raw[:-1], event
             if j and marks[j - 1].seq < since:
                 return
 
@@ -197,6 +201,13 @@ class LogHistory:
     def _valid(self, offset: int, since: int = 0) -> Iterator[tuple[int, int, bytes, dict]]:
         """(line offset, seq, line, event) for the machine's valid events from ``offset``; lines with a
         seq below ``since`` are passed over without validating them (a corrupt one cannot matter)."""
+        for line in self._lines(offset):
+            if line[1] >= since and validate(line[3]) is None:
+                yield line
+
+    def _lines(self, offset: int) -> Iterator[tuple[int, int, bytes, dict]]:
+        """(line offset, seq, line, object) for each line from ``offset`` that parses as an object naming
+        this machine with an integer seq: an event, unless ``validate`` says otherwise."""
         machine = self.machine
         try:
             handle = open(self.path, "rb")
@@ -211,7 +222,7 @@ class LogHistory:
                 if type(event) is not dict or event.get("machine") != machine:
                     continue
                 seq = event.get("seq")
-                if type(seq) is not int or seq < since or validate(event) is not None:
+                if type(seq) is not int:
                     continue
                 yield line_offset, seq, raw, event
 
@@ -241,23 +252,23 @@ class LogHistory:
     def _read_index(self) -> None:
         """Add the marks of the .idx lines written since the last call (none when there is no .idx)."""
         try:
-            handle = open(index_path(self.path), "rb")
+            index, log = open(index_path(self.path), "rb"), open(self.path, "rb")
         except OSError:
             return
-        with handle:
-            for offset, raw in complete_lines(handle, self._idx_read):
+        with index, log:
+            for offset, raw in complete_lines(index, self._idx_read):
                 self._idx_read = offset + len(raw)
                 try:
                     entry = loads(raw)
                 except ValueError:
                     continue
                 if type(entry) is dict and entry.get("machine") == self.machine:
-                    mark = self._index_mark(entry)
+                    mark = self._index_mark(entry, log)
                     if mark is not None:
                         self._add(mark)
 
-    def _index_mark(self, entry: dict) -> Mark | None:
-        """A mark from one .idx entry, when it points at a line start past the previous mark."""
+    def _index_mark(self, entry: dict, log: Any) -> Mark | None:
+        """A mark from one .idx entry, when it points at a line start of ``log`` past the previous mark."""
         seq, offset, t = entry.get("seq"), entry.get("offset"), entry.get("t")
         if type(seq) is not int or type(offset) is not int or offset <= 0:
             return None
@@ -268,12 +279,8 @@ class LogHistory:
             start = self._start(mark)
             mark.t = start[0].last_t if start is not None else None
             return mark if mark.t is not None else None
-        try:
-            with open(self.path, "rb") as handle:
-                handle.seek(offset - 1)
-                return mark if handle.read(2) == b"\n{" else None
-        except OSError:
-            return None
+        log.seek(offset - 1)
+        return mark if log.read(2) == b"\n{" else None
 
     def _scan(self, seq: int | None, t: float | None, end: bool) -> None:
         """Continue the scan until past ``seq`` / ``t`` (or to the end), adding a mark every ``every`` events."""

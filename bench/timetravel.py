@@ -1,0 +1,128 @@
+"""Time-travel benchmarks (issue 9): seeking and paging a 1,000,000-event recorded run, a table against
+the targets, each figure the median of 5 runs.
+
+Server rows: GET .../status?seq= and GET .../history over HTTP (one kept-alive connection) to a real
+uvicorn serving the run as a replay does (``History.from_log``: everything read from the recording,
+through its .idx). Targets: the status at event 1,000,000 <= 50 ms; a page of 1,000 events <= 20 ms
+at the start, the middle and the end of the run.
+
+The log is written once by the real Recorder (bench/replay.py's ``generate``: a two-state loop);
+``--log PATH`` keeps it there and reuses it on the next run. To add rows, append ``Row``s to what
+``main`` measures (a row is a name, a target in seconds or None, and a function to time).
+
+    .venv/bin/python bench/timetravel.py [--events N] [--log PATH]
+"""
+
+import argparse
+import os
+import shutil
+import statistics
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import httpx  # noqa: E402
+from fsm.logfiles.log_reader import read_events  # noqa: E402
+from replay import generate  # noqa: E402  (the 1M-event recording of bench/replay.py)
+from server.history import History  # noqa: E402
+from server.http_server import ServerThread  # noqa: E402
+
+REPEATS = 5
+MACHINE = "loop"  # the name bench/replay.py's generate records under
+
+
+@dataclass
+class Row:
+    name: str
+    target: Optional[float]  # seconds; None: shown for information
+    measure: Callable[[], None]
+
+
+def median_time(fn: Callable[[], None]) -> float:
+    times = []
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times)
+
+
+def print_table(title: str, rows: list[Row]) -> None:
+    results = [(row, median_time(row.measure)) for row in rows]
+    width = max(len(row.name) for row in rows)
+    print(title)
+    print("%-*s  %10s  %10s  %s" % (width, "measure", "target", "median", "result"))
+    print("-" * (width + 36))
+    for row, seconds in results:
+        target = "<= %g ms" % (row.target * 1000) if row.target is not None else ""
+        verdict = "" if row.target is None else ("met" if seconds <= row.target else "MISSED")
+        print("%-*s  %10s  %7.1f ms  %s" % (width, row.name, target, seconds * 1000, verdict))
+
+
+def serve(path: str) -> ServerThread:
+    """A real server showing the recording as machine MACHINE, its history read from the log alone."""
+    srv = ServerThread()
+    first = next(read_events(path))
+    srv.hub.ingest(first, "replay")
+    srv.hub.get(MACHINE).history = History.from_log(path, MACHINE)
+    return srv.start()
+
+
+def getter(http: httpx.Client, url: str, **params: object) -> Callable[[], None]:
+    def get() -> None:
+        answer = http.get(url, params=params)
+        answer.raise_for_status()
+    return get
+
+
+def server_rows(http: httpx.Client, path: str, last: int) -> list[Row]:
+    status = "/api/machines/%s/status" % MACHINE
+    history = "/api/machines/%s/history" % MACHINE
+    target = min(1_000_000, last)
+    t_target = History.from_log(path, MACHINE).page(since=target, limit=1)["events"][0]["t"]
+
+    def first_question() -> None:  # a fresh log: its .idx is read on the way
+        History.from_log(path, MACHINE).status_at(target)
+
+    return [
+        Row("status at event %d (?seq=)" % target, 0.050, getter(http, status, seq=target)),
+        Row("status at the time of event %d (?t=)" % target, None, getter(http, status, t=t_target)),
+        Row("status at event %d, a log just opened (in process)" % target, None, first_question),
+        Row("page of 1,000 events at the start", 0.020, getter(http, history, since=1, limit=1000)),
+        Row("page of 1,000 events in the middle", 0.020, getter(http, history, since=last // 2, limit=1000)),
+        Row("page of 1,000 events at the end (order=desc)", 0.020, getter(http, history, limit=1000, order="desc")),
+        Row("page of 1,000 events before the middle (order=desc)", None,
+            getter(http, history, until=last // 2, limit=1000, order="desc")),
+    ]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--events", type=int, default=1_050_000)
+    parser.add_argument("--log", help="the recording to write once and reuse (default: a temporary file)")
+    args = parser.parse_args()
+    directory = None if args.log else tempfile.mkdtemp(prefix="fsmscope-bench-")
+    path = args.log or os.path.join(directory, "loop.jsonl")
+    if not os.path.exists(path):
+        generate(path, args.events)
+    srv = serve(path)
+    try:
+        http = httpx.Client(base_url=srv.base_url, headers={"Authorization": "Bearer " + srv.token}, timeout=30)
+        span = History.from_log(path, MACHINE).span()
+        http.get("/api/machines/%s/status" % MACHINE, params={"seq": 1}).raise_for_status()  # opens the log
+        rows = server_rows(http, path, span["last_seq"])
+        print_table("fsmscope time-travel benchmark: %d events (%.0f MB), median of %d"
+                    % (span["last_seq"], os.path.getsize(path) / 1e6, REPEATS), rows)
+    finally:
+        srv.stop()
+        if directory is not None:
+            shutil.rmtree(directory)
+
+
+if __name__ == "__main__":
+    main()

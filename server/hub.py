@@ -38,6 +38,7 @@ class MachineEntry(Feed):
         self.rejected = 0  # events refused at the door (ingest) for not fitting the schema
         self.connected: bool | None = None  # ingest: whether its publisher is connected (None: not ingested)
         self.handle: MachineHandle | None = None  # local machines only
+        self.replay: dict | None = None  # replayed from a log: {"speed": the page's initial play speed}
         self.reporter: introspection.Reporter | None = None
         self.observer: Observer | None = None
         self.history = History(self)  # its past (server/history.py): the ring, and a recording when it has one

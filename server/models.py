@@ -38,6 +38,10 @@ class ScenePoseShown(BaseModel):
     live: bool = Field(description="the 3D view shows the live robot again (the request's pose was null)")
 
 
+class ReplayInfo(BaseModel):
+    speed: float = Field(description="the play speed the page opens with (--speed), 0.1 to 10")
+
+
 class MachineInfo(BaseModel):
     name: str
     running: bool
@@ -52,6 +56,8 @@ class MachineInfo(BaseModel):
     connected: Optional[bool] = Field(default=None, description="a machine of another process: whether its "
                                       "publisher is connected (null for the others)")
     rejected: int = Field(default=0, description="events refused at the door for not fitting the schema")
+    replay: Optional[ReplayInfo] = Field(default=None, description="a machine of `fsmscope replay --serve` "
+                                         "(source replay): how the page plays it; null for the others")
 
 
 class Transition(BaseModel):

@@ -139,6 +139,13 @@ def test_replay_serve_of_an_empty_file_exits_2_instead_of_serving(tmp_path):
     assert "fsmscope replay: %s: no events (the file is empty)" % log in done.stderr
 
 
+@pytest.mark.parametrize("speed", ["0", "11", "nan", "fast"])
+def test_replay_serve_refuses_a_speed_the_page_cannot_play(foo_bar_log, speed):
+    done = cli("replay", foo_bar_log, "--serve", "--speed", speed, timeout=20)
+    assert done.returncode == 2
+    assert "--speed" in done.stderr and "Traceback" not in done.stderr
+
+
 @pytest.mark.parametrize("command", [["serve"], ["run", os.path.join(EXAMPLES, "foo_bar.py")]],
                          ids=["serve", "run"])
 def test_a_command_whose_port_is_taken_says_why_and_exits_1(tmp_path, command):
@@ -257,12 +264,12 @@ def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, si
 
 def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_log):
     proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve",
-                             "--speed", "0", "--token", "replay-token"],
+                             "--speed", "2", "--token", "replay-token"],
                             cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
         url = None
         for line in proc.stderr:
-            found = re.search(r"still serving at (http://\S+)/\?token=", line)
+            found = re.search(r"replaying \S+ at (http://\S+)/\?token=", line)
             if found:
                 url = found.group(1)
                 break
@@ -270,6 +277,7 @@ def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_lo
         headers = {"Authorization": "Bearer replay-token"}
         machines = {m["name"]: m for m in httpx.get(url + "/api/machines", headers=headers).json()}
         assert machines["foo_bar"]["source"] == "replay" and machines["foo_bar"]["outcome"] == "end"
+        assert machines["foo_bar"]["replay"] == {"speed": 2.0}
         preempt = httpx.post(url + "/api/machines/foo_bar/preempt", json={}, headers=headers)
         assert preempt.status_code == 409 and "replayed" in preempt.json()["detail"]
     finally:

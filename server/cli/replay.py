@@ -1,11 +1,11 @@
 """``fsmscope replay LOG``: a recorded run printed as SMACH's log lines, then its statistics; with
-``--serve``, fed to the dashboard at its recorded pace instead."""
+``--serve``, the whole log loaded into the dashboard instead, where the page scrubs and plays it."""
 
 from __future__ import annotations
 
 import argparse
+import math
 import sys
-import time
 from typing import TYPE_CHECKING
 
 from .serving import add_server_arguments, start_server, wait_for_interrupt
@@ -13,10 +13,12 @@ from .serving import add_server_arguments, start_server, wait_for_interrupt
 if TYPE_CHECKING:
     from fsm.logfiles.log_reader import Reader
 
+    from ..hub import Hub
+
 HELP = "print a recorded run as SMACH's log lines, then its statistics"
 PASSES_ARGUMENTS_ON = False
 EXIT_UNREADABLE = 2  # the log cannot be read, or holds not one complete event
-MAX_GAP = 2.0  # seconds: the longest a browser replay waits between two events
+SPEEDS = (0.1, 10.0)  # the page's play speeds
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -27,10 +29,22 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-transcript", action="store_true", help="print only the summary")
     parser.add_argument("--no-time", action="store_true", help="leave the timestamps out of the transcript")
     parser.add_argument("--serve", action="store_true",
-                        help="replay into the dashboard instead of the terminal (view only)")
-    parser.add_argument("--speed", type=float, default=1.0,
-                        help="with --serve: pace relative to the recording (default 1; 0: as fast as possible)")
+                        help="load it into the dashboard instead, to scrub and play there (view only)")
+    parser.add_argument("--speed", type=play_speed, default=1.0,
+                        help="with --serve: the page's play speed when it opens, relative to the recording "
+                             "(%g to %g, default 1)" % SPEEDS)
     add_server_arguments(parser, 0)
+
+
+def play_speed(text: str) -> float:
+    """``--speed``: a number within the page's play speeds."""
+    try:
+        speed = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError("%r is not a number" % text) from None
+    if not (math.isfinite(speed) and SPEEDS[0] <= speed <= SPEEDS[1]):
+        raise argparse.ArgumentTypeError("%s is not within %g to %g" % (text, *SPEEDS))
+    return speed
 
 
 def main(args: argparse.Namespace) -> int:
@@ -95,54 +109,49 @@ def replay_in_terminal(args: argparse.Namespace) -> int:
     return summary.exit_code()
 
 
-def _sleep_until_due(start: float, offset: float) -> float:
-    """Sleep until ``start + offset`` (monotonic), waiting MAX_GAP at the most: a long idle gap
-    in a log is shortened, and the returned start shifts by what was skipped."""
-    delay = start + offset - time.monotonic()
-    if delay > MAX_GAP:
-        start -= delay - MAX_GAP
-        delay = MAX_GAP
-    if delay > 0:
-        time.sleep(delay)
-    return start
+def load(hub: Hub, reader: Reader, speed: float) -> int:
+    """Every complete event of the log into ``hub`` through its ingest door, in one scan: each
+    machine is served as source "replay" with its Status at the log's end and its timeline index
+    (server/timeline.py) built on the way, its history read from the log (server/history.py);
+    returns the number of events."""
+    from fsm.logfiles.log_reader import read_events
+
+    from ..history import History
+
+    count = 0
+    for event in read_events(reader.path, reader=reader):
+        hub.ingest(event, "replay")
+        count += 1
+    for entry in hub.machines():
+        entry.replay = {"speed": speed}
+        entry.history = History.from_log(reader.path, entry.name)
+    return count
 
 
 def replay_in_browser(args: argparse.Namespace) -> int:
-    """Feed a log to the dashboard at its recorded pace (times ``--speed``) through the hub's
-    ingest path, so the page cannot tell it from a live machine. The first event is shown at once;
-    the clock starts when a browser watches (``--speed 0``: no waiting at all)."""
-    from fsm.logfiles.log_reader import LogError, read_events
+    """Load the whole log, then serve it until Ctrl-C: a page (re)loaded at any time gets the
+    whole run (it opens paused at the start, at ``--speed``), nothing is paced here."""
+    from fsm.logfiles.log_reader import LogError
+
+    from ..hub import Hub
 
     reader = reader_of(args.log)
-    srv = start_server(args)
-    print("fsmscope: replaying %s at %s" % (args.log, srv.url), file=sys.stderr, flush=True)
-    count = 0
+    hub = Hub()
     try:
-        start = first = None
-        for event in read_events(args.log, reader=reader):
-            t = event.get("t")
-            paced = args.speed > 0 and isinstance(t, (int, float))
-            if paced and first is not None:
-                start = _sleep_until_due(start, (t - first) / args.speed)
-            srv.hub.loop.call_soon_threadsafe(srv.hub.ingest, event, "replay")
-            count += 1
-            if paced and first is None:
-                print("fsmscope: the replay starts when a browser opens it", file=sys.stderr, flush=True)
-                while not any(entry.clients for entry in srv.hub.machines()):
-                    time.sleep(0.1)
-                first, start = t, time.monotonic()
-        if not count:
-            print("fsmscope replay: %s" % no_events(reader), file=sys.stderr)
-            return EXIT_UNREADABLE
-        print("fsmscope: replayed %d events; still serving at %s (Ctrl-C stops)" % (count, srv.url),
-              file=sys.stderr, flush=True)
-        wait_for_interrupt()
-        code = 0
+        count = load(hub, reader, args.speed)
     except LogError as exc:
         print("fsmscope replay: %s" % exc, file=sys.stderr)
-        code = EXIT_UNREADABLE
+        return EXIT_UNREADABLE
     except KeyboardInterrupt:
-        code = 0
+        return 0
+    if not count:
+        print("fsmscope replay: %s" % no_events(reader), file=sys.stderr)
+        return EXIT_UNREADABLE
+    srv = start_server(args, hub=hub)
+    print("fsmscope: replaying %s at %s (%d events loaded; Ctrl-C stops)" % (args.log, srv.url, count),
+          file=sys.stderr, flush=True)
+    try:
+        wait_for_interrupt()
     finally:
         srv.stop()
-    return code
+    return 0

@@ -27,7 +27,8 @@ async def list_machines(hub: HubDep) -> list[dict]:
                     "can_start": bool(handle is not None and handle.can_start),
                     "can_hold": bool(handle is not None and handle.holder is not None),
                     "held": bool(handle is not None and handle.held),
-                    "source": entry.source, "connected": entry.connected, "rejected": entry.rejected})
+                    "source": entry.source, "connected": entry.connected, "rejected": entry.rejected,
+                    "replay": entry.replay})
     return out
 
 

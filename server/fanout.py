@@ -161,7 +161,7 @@ class Feed:
         self._snapshot = (key[0], key[1], frame)
         return key[1], frame
 
-    def history(self, upto: int) -> str:
+    def run_history(self, upto: int) -> str:
         """The current run's events up to ``upto`` (from the ring, the newest ``HISTORY`` at most), as
         JSON ``{"complete", "events"}``; ``complete`` says whether it reaches back to the run's start."""
         with self.lock:
@@ -240,7 +240,7 @@ class Client:
         if missed > 0:
             frames.append('{"type":"missed","count":%d}' % missed)
         if not self.cursor:  # a new client: the snapshot also carries the current run's events so far
-            frame = frame[:-1] + ',"history":' + feed.history(seq) + "}"
+            frame = frame[:-1] + ',"history":' + feed.run_history(seq) + "}"
         frames.append(frame)
         self.need_snapshot = False
         self.cursor = seq + 1

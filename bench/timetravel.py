@@ -16,10 +16,8 @@ The log is written once by the real Recorder (bench/replay.py's ``generate``: a 
 import argparse
 import os
 import shutil
-import statistics
 import sys
 import tempfile
-import time
 from dataclasses import dataclass
 from typing import Callable, Optional
 
@@ -28,11 +26,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import httpx  # noqa: E402
 from fsm.logfiles.log_reader import read_events  # noqa: E402
-from replay import generate  # noqa: E402  (the 1M-event recording of bench/replay.py)
+from replay import REPEATS, generate, median_time  # noqa: E402  (bench/replay.py's 1M-event recording)
 from server.history import History  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
 
-REPEATS = 5
 MACHINE = "loop"  # the name bench/replay.py's generate records under
 
 
@@ -41,15 +38,6 @@ class Row:
     name: str
     target: Optional[float]  # seconds; None: shown for information
     measure: Callable[[], None]
-
-
-def median_time(fn: Callable[[], None]) -> float:
-    times = []
-    for _ in range(REPEATS):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return statistics.median(times)
 
 
 def print_table(title: str, rows: list[Row]) -> None:

@@ -103,17 +103,22 @@ def test_history_filters_by_kinds_and_path(recorded):
                                                   and e["path"] == "/SM_ROOT/SUB"]
 
 
-@pytest.mark.parametrize("params, message", [
-    ({"seq": 1, "t": 1.0}, "give seq or t, not both"),
-    ({"seq": -1}, "query.seq: Input should be greater than or equal to 0"),
-    ({"seq": "1.5"}, "query.seq: Input should be a valid integer"),
-    ({"seq": "abc"}, "query.seq: Input should be a valid integer"),
-    ({"t": "nan"}, "t must be a finite number of seconds, not nan"),
-    ({"t": "inf"}, "t must be a finite number of seconds, not inf"),
+@pytest.mark.parametrize("route, params, message", [
+    ("status", {"seq": 1, "t": 1.0}, "give seq or t, not both"),
+    ("status", {"seq": -1}, "query.seq: Input should be greater than or equal to 0"),
+    ("status", {"seq": "1.5"}, "query.seq: Input should be a valid integer"),
+    ("status", {"seq": "abc"}, "query.seq: Input should be a valid integer"),
+    ("status", {"t": "nan"}, "t must be a finite number of seconds, not nan"),
+    ("status", {"t": "inf"}, "t must be a finite number of seconds, not inf"),
+    ("history", {"limit": 10001}, "query.limit: Input should be less than or equal to 10000"),
+    ("history", {"limit": 0}, "query.limit: Input should be greater than or equal to 1"),
+    ("history", {"since": 10, "until": 5}, "since (10) is after until (5)"),
+    ("history", {"kinds": "transition,bogus"}, "kinds: 'bogus' is not an event kind"),
+    ("history", {"order": "sideways"}, "query.order: Input should be 'asc' or 'desc'"),
 ])
-def test_a_bad_seek_is_422_with_a_message(recorded, params, message):
+def test_a_bad_request_is_422_with_a_message(recorded, route, params, message):
     _, http, _ = recorded
-    answer = http.get("/api/machines/m/status", params=params)
+    answer = http.get("/api/machines/m/" + route, params=params)
     assert answer.status_code == 422 and answer.json()["detail"].startswith(message)
 
 
@@ -123,19 +128,6 @@ def test_a_seek_beyond_the_last_event_is_416(recorded):
     answer = http.get("/api/machines/m/status", params={"seq": last + 5})
     assert answer.status_code == 416
     assert answer.json()["detail"] == "seq %d is beyond the last event (%d)" % (last + 5, last)
-
-
-@pytest.mark.parametrize("params, message", [
-    ({"limit": 10001}, "query.limit: Input should be less than or equal to 10000"),
-    ({"limit": 0}, "query.limit: Input should be greater than or equal to 1"),
-    ({"since": 10, "until": 5}, "since (10) is after until (5)"),
-    ({"kinds": "transition,bogus"}, "kinds: 'bogus' is not an event kind"),
-    ({"order": "sideways"}, "query.order: Input should be 'asc' or 'desc'"),
-])
-def test_a_bad_page_request_is_422_with_a_message(recorded, params, message):
-    _, http, _ = recorded
-    answer = http.get("/api/machines/m/history", params=params)
-    assert answer.status_code == 422 and answer.json()["detail"].startswith(message)
 
 
 def test_an_unknown_machine_is_404_for_both(live_server):

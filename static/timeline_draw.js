@@ -180,6 +180,8 @@ export class Painter {
     ctx.beginPath();
     ctx.rect(0, top, g.w, g.h - top);
     ctx.clip();
+    const fills = new Map(); // fill style -> the path of every band of that colour
+    const texts = [];
     for (let r = first; r < last; r++) {
       const row = data.rows[r];
       const y = top + r * rowH - g.scrollTop;
@@ -187,8 +189,14 @@ export class Painter {
         ctx.fillStyle = COLOURS.selected;
         ctx.fillRect(0, y, g.w, rowH);
       }
-      this.bands(g, data, row, y + 2, rowH - 4);
+      this.bands(g, data, row, y + 2, rowH - 4, fills, texts);
     }
+    for (const [style, path] of fills) {
+      ctx.fillStyle = style;
+      ctx.fill(path);
+    }
+    ctx.fillStyle = COLOURS.text;
+    for (const [text, x, y] of texts) ctx.fillText(text, x, y);
     ctx.beginPath();
     ctx.rect(0, top, LAYOUT.labelW - 4, g.h - top);
     ctx.clip();
@@ -200,9 +208,9 @@ export class Painter {
     ctx.restore();
   }
 
-  /** One row's bands in the visible range: at most one rectangle per pixel column. */
-  bands(g, data, row, y, h) {
-    const { ctx } = this;
+  /** One row's bands in the visible range, at most one per pixel column, added to `fills` (by colour)
+   * and their labels that fit to `texts`: one fill per colour for the frame, not one per band. */
+  bands(g, data, row, y, h, fills, texts) {
     const left = LAYOUT.labelW + 1;
     let lastX = -Infinity;
     for (let i = lowerBound(row.t1, g.v0, row.n); i < row.n && row.t0[i] <= g.v1; i++) {
@@ -213,12 +221,11 @@ export class Painter {
       const x = Math.max(x0, lastX), w = Math.max(1, x1 - x);
       lastX = Math.floor(x + w);
       const text = label === MANY ? null : data.labels[label];
-      ctx.fillStyle = text === null ? this.hatch : labelColour(this.colours, text);
-      ctx.fillRect(x, y, w, h);
-      if (text !== null && w > 24 && this.textWidth(text) + 8 <= w) {
-        ctx.fillStyle = COLOURS.text;
-        ctx.fillText(text, x + 4, y + h / 2);
-      }
+      const style = text === null ? this.hatch : labelColour(this.colours, text);
+      let path = fills.get(style);
+      if (!path) fills.set(style, (path = new Path2D()));
+      path.rect(x, y, w, h);
+      if (text !== null && w > 24 && this.textWidth(text) + 8 <= w) texts.push([text, x + 4, y + h / 2]);
     }
   }
 

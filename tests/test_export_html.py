@@ -193,7 +193,6 @@ SHOWN = """(() => {
         containers: Object.fromEntries(Object.entries(s.containers).map(([p, c]) => [p, {userdata: c.userdata, changes: c.changes}])),
         log_row: row && [row.dataset.seq, row.querySelector('.kind').textContent, row.querySelector('.msg').textContent],
         userdata_rows: [...document.querySelectorAll('#userdata tr.ud-row')].map((r) => [r.dataset.key, r.className, r.querySelector('td.value').textContent]),
-        past: document.querySelector('#past-text').textContent,
     };
 })()"""
 

@@ -139,3 +139,15 @@ def test_names_with_markup_are_drawn_as_text(page):
     page.wait_for_function("text => document.querySelector('#tl-test canvas').title.includes(text)", arg=MARKUP)
     assert page.evaluate("document.querySelectorAll('img').length") == 0
     assert page.evaluate("window.pwned") is None
+
+
+def test_choosing_a_speed_asks_the_page_for_it(page):
+    build(page)
+    page.select_option("#tl-test select", "2")
+    assert calls(page, "speed") == [[2]]
+
+
+def test_a_speed_the_page_shows_is_selected_even_when_not_a_choice(page):
+    build(page)
+    page.evaluate("tl.showSpeed(3)")
+    assert page.input_value("#tl-test select") == "3"

@@ -12,6 +12,7 @@ from fsm.observation.status import Status
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from recording_support import record
+from server import history as history_module
 from server.history import History, HistoryError, LogHistory
 from smach_support import counting_machine
 
@@ -207,3 +208,14 @@ def test_a_log_of_two_machines_answers_for_the_one_asked(tmp_path):
     seq = second[len(second) // 2]["seq"]
     assert log.status_at(seq).to_dict() == status_after(second, seq, "two")
     assert seqs_of(History(None, log).page(limit=10_000)) == [e["seq"] for e in second]
+
+
+def test_a_filtered_page_stops_after_its_scan_budget_and_the_next_one_goes_on(recorded, monkeypatch):
+    path, seen = recorded
+    monkeypatch.setattr(history_module, "SCAN_BUDGET", 500)
+    history = History.from_log(path, "m")
+    terminates = [e["seq"] for e in seen if e["kind"] == "terminate"]
+    first = history.page(kinds={"terminate"})
+    assert first["more"] is True and seqs_of(first) == [s for s in terminates if s < first["next"]]
+    assert seqs_of(history.page(since=first["next"], kinds={"terminate"}))[0] == \
+        [s for s in terminates if s >= first["next"]][0]

@@ -194,3 +194,15 @@ def test_openapi_documents_both_with_examples(live_server):
     assert {p["name"] for p in history["parameters"]} >= {"since", "until", "limit", "kinds", "path", "order"}
     for name in ("MachineStatus", "HistoryPage"):
         assert spec["components"]["schemas"][name]["examples"]
+
+
+def test_a_machine_of_another_process_answers_its_recent_past_from_memory(live_server, tmp_path, quiet):
+    path = run_recorded(live_server, tmp_path, 400, name="recorded")
+    events = [dict(e, machine="remote") for e in read_events(path) if e["kind"] != "snapshot"]
+    for event in events:
+        live_server.hub.loop.call_soon_threadsafe(live_server.hub.ingest, event, "ingest")
+    http = client(live_server)
+    wait_for(lambda: http.get("/api/machines/remote/status").json()["last_seq"] == events[-1]["seq"])
+    for seq in (1, 1000, 1001, 2345):
+        assert past(http.get("/api/machines/remote/status", params={"seq": seq}).json()) == \
+            dict(past(seek(path, "recorded", seq).status.to_dict()), machine="remote")

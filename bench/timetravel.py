@@ -6,6 +6,11 @@ uvicorn serving the run as a replay does (``History.from_log``: everything read 
 through its .idx). Targets: the status at event 1,000,000 <= 50 ms; a page of 1,000 events <= 20 ms
 at the start, the middle and the end of the run.
 
+Timeline rows: GET .../timeline of the whole run (target <= 50 ms) and of one second of its middle,
+from the machine's TimelineIndex built in one scan as ``fsmscope replay --serve`` builds it; and
+what the index costs the machine: ``Feed.observe`` (the hub's work in the machine's thread) over
+100,000 of the run's events with the index and with it switched off.
+
 The log is written once by the real Recorder (bench/replay.py's ``generate``: a two-state loop);
 ``--log PATH`` keeps it there and reuses it on the next run. To add rows, append ``Row``s to what
 ``main`` measures (a row is a name, a target in seconds or None, and a function to time).
@@ -28,7 +33,9 @@ import httpx  # noqa: E402
 from fsm.logfiles.log_reader import read_events  # noqa: E402
 from replay import REPEATS, generate, median_time  # noqa: E402  (bench/replay.py's 1M-event recording)
 from server.history import History  # noqa: E402
+from server.fanout import Feed  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
+from server.timeline import TimelineIndex  # noqa: E402
 
 MACHINE = "loop"  # the name bench/replay.py's generate records under
 
@@ -89,6 +96,43 @@ def server_rows(http: httpx.Client, path: str, last: int) -> list[Row]:
     ]
 
 
+class NoIndex:
+    """A feed's timeline switched off, to see what the index costs."""
+
+    def add(self, event: dict) -> None:
+        pass
+
+
+def observing(events: list[dict], indexed: bool) -> Callable[[], None]:
+    def observe() -> None:
+        feed = Feed(MACHINE)
+        if not indexed:
+            feed.timeline = NoIndex()
+        for event in events:
+            feed.observe(event)
+    return observe
+
+
+def timeline_rows(http: httpx.Client, srv: ServerThread, path: str) -> list[Row]:
+    index = TimelineIndex()
+    events = []
+    for event in read_events(path):
+        index.add(event)
+        if len(events) < 100_000 and event["kind"] != "snapshot":
+            events.append(event)
+    srv.hub.get(MACHINE).timeline = index
+    url = "/api/machines/%s/timeline" % MACHINE
+    span = index.answer(buckets=1)
+    middle = (span["first"]["t"] + span["last"]["t"]) / 2
+    return [
+        Row("timeline of the whole run", 0.050, getter(http, url)),
+        Row("timeline of 1 s in the middle, 10,000 buckets", None,
+            getter(http, url, since_t=middle, until_t=middle + 1, buckets=10_000)),
+        Row("Feed.observe of 100,000 events, timeline index on", None, observing(events, True)),
+        Row("Feed.observe of 100,000 events, timeline index off", None, observing(events, False)),
+    ]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--events", type=int, default=1_050_000)
@@ -103,7 +147,7 @@ def main() -> None:
         http = httpx.Client(base_url=srv.base_url, headers={"Authorization": "Bearer " + srv.token}, timeout=30)
         span = History.from_log(path, MACHINE).span()
         http.get("/api/machines/%s/status" % MACHINE, params={"seq": 1}).raise_for_status()  # opens the log
-        rows = server_rows(http, path, span["last_seq"])
+        rows = server_rows(http, path, span["last_seq"]) + timeline_rows(http, srv, path)
         print_table("fsmscope time-travel benchmark: %d events (%.0f MB), median of %d"
                     % (span["last_seq"], os.path.getsize(path) / 1e6, REPEATS), rows)
     finally:

@@ -17,7 +17,6 @@ from __future__ import annotations
 
 from array import array
 from bisect import bisect_left, bisect_right
-from typing import Any
 
 MAX_MARKS = 1_000_000     # transitions kept in full detail (per machine) before the older half is coalesced
 COARSE_BUCKETS = 10_000   # buckets the coalesced part keeps
@@ -45,27 +44,27 @@ class _Track:
 
 def _bands(track: _Track, lo: float, hi: float, width: float, end: float) -> list[list]:
     """``[t0, t1, seq0, label]`` for the part of ``track`` within [lo, hi]; a mark's band ends at the
-    next mark (the last one at ``end``). Runs of bands shorter than ``width`` become one "…" band
-    reaching at least ``width``, so there are at most (hi - lo) / width + 2 bands whatever the marks."""
+    next mark (the last one at ``end``). A band shorter than ``width`` starts a "…" band ``width``
+    long (the marks within it), after which the last of those marks goes on; adjacent "…" merge, so
+    every band but the first and last is at least ``width`` long: at most (hi - lo) / width + 2."""
     labels = track.label
     n = len(labels)  # first: ``add`` appends to t and seq before label
     ts, seqs = track.t, track.seq
     stop = bisect_right(ts, hi, 0, n)
     i = max(bisect_right(ts, lo, 0, stop) - 1, 0)
     out: list[list] = []
+    floor = lo  # where the current mark's band starts when a "…" band took its beginning
     while i < stop:
-        start = max(ts[i], lo)
+        start = max(ts[i], floor)
         nxt = ts[i + 1] if i + 1 < n else end
         if nxt - start >= width or i + 1 >= stop:
             band, i = [start, min(nxt, hi), seqs[i], labels[i]], i + 1
             if band[1] <= start and i < stop:  # an empty band, not the last
                 continue
-        else:
-            j = min(bisect_left(ts, start + width, i + 2, stop), stop - 1)
-            if j <= i + 1:  # only the last mark in range follows: this one stays itself
-                band, i = [start, nxt, seqs[i], labels[i]], i + 1
-            else:
-                band, i = [start, ts[j], seqs[i], MANY], j
+        else:  # the marks starting within [start, start + width) make one "…" band; the last goes on after it
+            cut = min(start + width, hi)
+            k = max(bisect_left(ts, cut, i + 1, stop), i + 2)  # at least one mark on, even when cut is hi
+            band, i, floor = [start, cut, seqs[i], MANY], k - 1, cut
         if out and out[-1][3] == band[3]:
             out[-1][1] = band[1]
         else:

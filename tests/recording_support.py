@@ -1,7 +1,10 @@
 """Helpers shared by the recording, replay, CLI and example tests."""
 
+import contextlib
 import os
+import re
 import runpy
+import signal
 import subprocess
 import sys
 
@@ -36,6 +39,28 @@ def cli(*args, cwd=None, env=None, timeout=60):
         args = ("run", "--exit") + tuple(args[1:])
     return subprocess.run([sys.executable, "-m", "server.cli", *map(str, args)], cwd=cwd or ROOT, env=full_env,
                           capture_output=True, text=True, timeout=timeout)
+
+
+@contextlib.contextmanager
+def replay_served(log, *args):
+    """``fsmscope replay LOG --serve ARGS`` in a real process: yields (the address it printed, token
+    included; the stderr lines before it); ended with Ctrl-C, as a user would, which exits 0."""
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve", *map(str, args)],
+                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        said = []
+        for line in proc.stderr:
+            found = re.search(r"replaying \S+ at (http://\S+)", line)
+            if found:
+                break
+            said.append(line)
+        else:
+            raise AssertionError("fsmscope replay --serve printed no address: %r" % said)
+        yield found.group(1), said
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        code = proc.wait(20)
+    assert code == 0, "fsmscope replay --serve exited %d on Ctrl-C" % code
 
 
 def two_state_loop(n):

@@ -3,15 +3,11 @@
 from __future__ import annotations
 
 import os
-import re
-import signal
-import subprocess
-import sys
 import time
 
 import fsm
 import pytest
-from browser_support import ROOT
+from recording_support import replay_served
 from server.testing.browser import CHROMIUM, launch_chromium, open_page
 
 
@@ -37,19 +33,8 @@ def replay_url(tmp_path):
         pytest.skip("Debian's chromium is not installed (make apt)")
     log = tmp_path / "abc.jsonl"
     record_abc(log)
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve"],
-                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        for line in proc.stderr:
-            found = re.search(r"replaying \S+ at (http://\S+)", line)
-            if found:
-                yield found.group(1)
-                break
-        else:
-            pytest.fail("fsmscope replay --serve printed no URL")
-    finally:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(20)
+    with replay_served(log) as (url, _):
+        yield url
 
 
 @pytest.fixture

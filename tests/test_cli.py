@@ -14,7 +14,7 @@ import httpx
 import pytest
 from fsm.observation.encoding import dumps
 
-from recording_support import EXAMPLES, ROOT, cli
+from recording_support import EXAMPLES, ROOT, cli, replay_served
 from server.testing.polling import wait_for
 
 
@@ -263,23 +263,10 @@ def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, si
 
 
 def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_log):
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve",
-                             "--speed", "2", "--token", "replay-token"],
-                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        url = None
-        for line in proc.stderr:
-            found = re.search(r"replaying \S+ at (http://\S+)/\?token=", line)
-            if found:
-                url = found.group(1)
-                break
-        assert url, "no URL printed"
-        headers = {"Authorization": "Bearer replay-token"}
-        machines = {m["name"]: m for m in httpx.get(url + "/api/machines", headers=headers).json()}
+    with replay_served(foo_bar_log, "--speed", "2", "--token", "replay-token") as (url, _):
+        base, headers = url.split("/?")[0], {"Authorization": "Bearer replay-token"}
+        machines = {m["name"]: m for m in httpx.get(base + "/api/machines", headers=headers).json()}
         assert machines["foo_bar"]["source"] == "replay" and machines["foo_bar"]["outcome"] == "end"
         assert machines["foo_bar"]["replay"] == {"speed": 2.0}
-        preempt = httpx.post(url + "/api/machines/foo_bar/preempt", json={}, headers=headers)
+        preempt = httpx.post(base + "/api/machines/foo_bar/preempt", json={}, headers=headers)
         assert preempt.status_code == 409 and "replayed" in preempt.json()["detail"]
-    finally:
-        os.killpg(proc.pid, signal.SIGINT)
-        assert proc.wait(20) == 0

@@ -2,17 +2,12 @@
 every machine served at the log's end, with its timeline."""
 
 import contextlib
-import os
-import re
-import signal
-import subprocess
-import sys
 
 import httpx
 from fsm.logfiles.log_reader import read_events, seek
 from fsm.observation.status import rebuild
 
-from recording_support import ROOT, record
+from recording_support import record, replay_served
 from server_support import sleeper
 from smach_support import machine
 
@@ -21,23 +16,10 @@ TOKEN = "replay-serve-token"
 
 @contextlib.contextmanager
 def replaying(log):
-    """``fsmscope replay LOG --serve``: yields (an HTTP client of it, the stderr lines before its URL)."""
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve", "--token", TOKEN],
-                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        said = []
-        for line in proc.stderr:
-            found = re.search(r"replaying \S+ at (http://\S+)/\?token=", line)
-            if found:
-                break
-            said.append(line)
-        else:
-            raise AssertionError("fsmscope replay --serve printed no URL: %r" % said)
-        with httpx.Client(base_url=found.group(1), headers={"Authorization": "Bearer " + TOKEN}) as client:
+    """``fsmscope replay LOG --serve``: yields (an HTTP client of it, the stderr lines before its address)."""
+    with replay_served(log, "--token", TOKEN) as (url, said):
+        with httpx.Client(base_url=url.split("/?")[0], headers={"Authorization": "Bearer " + TOKEN}) as client:
             yield client, said
-    finally:
-        os.killpg(proc.pid, signal.SIGINT)
-        assert proc.wait(20) == 0
 
 
 def recorded_nested_run(path):

@@ -4,7 +4,6 @@
 
 import { api } from "./api.js";
 import { showBadge } from "./badge.js";
-import { clockText } from "./clocktext.js";
 import { readLink, writeLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
 import { Depth } from "./depth.js";
@@ -14,6 +13,7 @@ import { Machines, isReplay, showRunState } from "./machines.js";
 import { RunNotices, notice } from "./notice.js";
 import { EventLog } from "./eventlog.js";
 import { Playhead } from "./timetravel.js";
+import { Timeline } from "./timeline.js";
 import { TreeView } from "./tree.js";
 import { UserdataPanel, keyHistory } from "./userdata.js";
 import { SceneView } from "./scene.js";
@@ -28,6 +28,8 @@ const store = new Store();
 let stream = null; // the stream of the machine shown
 let renderQueued = false;
 const KEY_HISTORY_LIMIT = 10000; // events of a run read for one key's history
+const TIMELINE_REFRESH_MS = 1000; // a live machine's timeline is asked again this often
+let timelineRange = { since_t: null, until_t: null }; // the range the timeline shows (null: the whole run)
 
 const playhead = new Playhead(api, {
   changed: () => queueRender(),
@@ -62,6 +64,18 @@ const log = new EventLog($("log"), {
   },
 });
 log.nodeOf = (path) => store.nodes.get(path);
+const timeline = new Timeline($("timeline"), {
+  seek: (target) => playhead.seek(target),
+  range: (range) => {
+    timelineRange = range;
+    loadTimeline();
+  },
+  play: () => playhead.play(),
+  pause: () => playhead.pause(),
+  speed: (x) => playhead.setSpeed(x),
+  step: (direction, path) => playhead.step(direction, path),
+  live: () => playhead.live(),
+});
 const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"), api.scenePose);
 const notices = new RunNotices();
 const machines = new Machines($("machine-picker"), store, {
@@ -80,7 +94,14 @@ function openMachine(name) {
   if (stream) stream.stop();
   store.open(name);
   const link = readLink();
-  playhead.open(name, isReplay(machines.list.find((m) => m.name === name)), link.machine === name ? link.seq : null);
+  const entry = machines.list.find((m) => m.name === name);
+  playhead.open(name, isReplay(entry), link.machine === name ? link.seq : null);
+  if (entry?.replay?.speed) {
+    playhead.setSpeed(entry.replay.speed);
+    timeline.showSpeed(entry.replay.speed);
+  }
+  timelineRange = { since_t: null, until_t: null };
+  loadTimeline();
   machines.opened(name);
   depth.reset();
   notices.forget(); // they were about the machine shown so far
@@ -148,6 +169,18 @@ async function loadGraph() {
   }
 }
 
+/** Ask the server for the timeline of the machine shown, in the range the timeline shows. */
+async function loadTimeline() {
+  const name = store.name;
+  if (name === null) return;
+  try {
+    const data = await api.timeline(name, timelineRange);
+    if (name === store.name) timeline.setData(data);
+  } catch (err) {
+    if (name === store.name) notice("Could not read the timeline: " + (err.detail || err.message), "warn");
+  }
+}
+
 /** The history of `key` of container `path` in the current run, beside the userdata. */
 async function showKeyHistory(path, key) {
   const name = store.name;
@@ -190,7 +223,7 @@ function stateMenu(path, x, y) {
 
 function updateTopBar() {
   controls.update();
-  showRunState($("run-state"), store.status, machines.current());
+  showRunState($("run-state"), store.status && shownStatus(), machines.current());
 }
 
 function updateBadge() {
@@ -209,17 +242,16 @@ function shownStatus() {
   return playhead.past && playhead.status ? playhead.status : store.status;
 }
 
-/** The bar that says the page looks back, how far, and how to come back. */
-function showPast() {
-  const bar = $("past");
-  bar.hidden = !playhead.past;
-  if (!playhead.past) return;
-  const replay = playhead.replay;
-  const behind = playhead.behind(store.status);
-  const at = `${clockText(playhead.t)}, event ${playhead.seq}`;
-  $("past-text").textContent = replay ? `replay: ${at}${playhead.playing ? ` (playing ×${playhead.speed})` : ""}`
-    : `viewing the past: ${clockText(playhead.t)}, ${behind} event${behind === 1 ? "" : "s"} behind`;
-  $("back-live").hidden = replay;
+/** The timeline's playhead, and the page framed as looking back when it does. */
+function showInstant() {
+  const live = store.status;
+  const past = playhead.past;
+  timeline.setInstant({
+    seq: past ? playhead.seq : live.last_seq, t: past ? playhead.t : live.last_t, live: !past,
+    behind: past && !playhead.replay ? playhead.behind(live) : null, playing: playhead.playing,
+    liveMachine: !playhead.replay,
+  });
+  document.body.classList.toggle("looking-back", past && !playhead.replay);
 }
 
 let linkTimer = null;
@@ -242,7 +274,7 @@ function render() {
   if (playhead.past && !playhead.window) log.freeze();
   else log.showPast(playhead.past ? playhead.window : null);
   log.flush();
-  showPast();
+  showInstant();
   scene.showPose(playhead.past ? s.pose : null);
   updateLink();
   machines.fillPicker();
@@ -254,7 +286,6 @@ function render() {
 // ---------------------------------------------------------------- go
 
 $("fit").addEventListener("click", () => graph.fit());
-$("back-live").addEventListener("click", () => playhead.live());
 $("zoom-in").addEventListener("click", () => graph.zoom(1.25));
 $("zoom-out").addEventListener("click", () => graph.zoom(0.8));
 $("follow").addEventListener("change", (e) => {
@@ -268,6 +299,9 @@ document.addEventListener("keydown", (e) => {
   else if (e.key === "-") graph.zoom(0.8);
 });
 setInterval(updateBadge, 500);
+setInterval(() => {
+  if (!playhead.replay && !document.hidden) loadTimeline(); // a live run grows
+}, TIMELINE_REFRESH_MS);
 setInterval(() => notices.checkOverdue(store.status), 500);
 
 // Read-only, for the console and the browser tests (the selected path, the status shown, the live one).

@@ -10,7 +10,6 @@ const WINDOW_BEFORE = 400; // events of the log shown before the instant
 const WINDOW_AFTER = 100; // and after it (greyed: not happened yet at the instant)
 const AHEAD = 1000; // events fetched ahead while playing
 const MAX_GAP = 2; // seconds of recorded time: a longer quiet stretch plays in this long
-export const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 5, 10];
 
 export class Playhead {
   /**

@@ -39,14 +39,17 @@ export function clockText(t) {
   return `${pad(d.getHours())}:${pad(d.getMinutes())}:${pad(d.getSeconds())}.${pad(d.getMilliseconds(), 3)}`;
 }
 
-/** One stable colour per label (a hash of its text picks the hue). */
+// Light enough for dark text; no grey (grey is "+" and "…").
+const PALETTE = ["#9ecae1", "#a1d99b", "#fdae6b", "#bcbddc", "#fc9272", "#f6e8a6", "#b3e2cd", "#f4b6c2",
+  "#6baed6", "#74c476", "#fdd0a2", "#d8b5a5", "#c7e9c0", "#dadaeb", "#cbd5a3", "#a6d8f0"];
+
+/** One stable colour per label (a hash of its text picks it from the palette). */
 function labelColour(cache, label) {
   let colour = cache.get(label);
   if (colour === undefined) {
     let hash = 2166136261;
     for (let i = 0; i < label.length; i++) hash = Math.imul(hash ^ label.charCodeAt(i), 16777619);
-    hash >>>= 0;
-    colour = label === "+" ? COLOURS.several : `hsl(${hash % 360} ${52 + (hash >>> 9) % 20}% ${76 + (hash >>> 17) % 8}%)`;
+    colour = label === "+" ? COLOURS.several : PALETTE[(hash >>> 0) % PALETTE.length];
     cache.set(label, colour);
   }
   return colour;
@@ -141,7 +144,8 @@ export class Painter {
       const x = Math.round(xOf(g, t)) + 0.5;
       grid.moveTo(x, LAYOUT.axisH - 5);
       grid.lineTo(x, g.h);
-      ctx.fillText(clockText(t), x + 3, LAYOUT.axisH / 2);
+      const text = clockText(t);
+      if (x + 3 + this.textWidth(text) <= g.w) ctx.fillText(text, x + 3, LAYOUT.axisH / 2);
     }
     ctx.strokeStyle = COLOURS.grid;
     ctx.stroke(grid);
@@ -224,7 +228,7 @@ export class Painter {
       const style = text === null ? this.hatch : labelColour(this.colours, text);
       let path = fills.get(style);
       if (!path) fills.set(style, (path = new Path2D()));
-      path.rect(x, y, w, h);
+      path.rect(x, y, w > 3 ? w - 1 : w, h); // a gap ends a band wide enough, should its neighbour share its colour
       if (text !== null && w > 24 && this.textWidth(text) + 8 <= w) texts.push([text, x + 4, y + h / 2]);
     }
   }

@@ -5,18 +5,14 @@ from __future__ import annotations
 
 import base64
 import json
-import os
 import re
 import shutil
-import signal
-import subprocess
-import sys
 import urllib.parse
 
 import fsm
 import pytest
-from browser_support import ACTIVE_LEAF, ROOT
-from recording_support import cli, record
+from browser_support import ACTIVE_LEAF
+from recording_support import cli, record, replay_served
 from smach_support import machine
 from fsm.logfiles.log_reader import seek
 from fsm.observation.schema import state_id
@@ -256,19 +252,8 @@ def test_clicking_a_log_row_shows_that_event(file_page, recorded):
 @pytest.fixture
 def replay_url(recorded):
     """The dashboard's address of `fsmscope replay LOG --serve` serving the same log, in a real process."""
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(recorded[0]), "--serve"],
-                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
-    try:
-        for line in proc.stderr:
-            found = re.search(r"replaying \S+ at (http://\S+)", line)
-            if found:
-                yield found.group(1)
-                break
-        else:
-            pytest.fail("fsmscope replay --serve printed no address")
-    finally:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(20)
+    with replay_served(recorded[0]) as (url, _):
+        yield url
 
 
 def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_page, browser, replay_url, recorded):

@@ -10,6 +10,13 @@ export const ZOOM_STEP = 1.5;
 
 const button = (text, title, cls) => h("button", { type: "button", text, title, class: cls });
 
+/** How far back the server's history reaches (when not to seq 1) and from where its detail is whole. */
+function keptText(first, keptFrom) {
+  const reach = first.seq > 1 ? `history reaches back to ${clockText(first.t)} (seq ${first.seq})` : "";
+  const coarse = keptFrom !== null && keptFrom > first.seq ? `full detail from seq ${keptFrom}` : "";
+  return [reach, coarse].filter(Boolean).join("; ");
+}
+
 export class TimelineControls {
   /** @param {Timeline} timeline whose actions the buttons and keys call */
   constructor(timeline) {
@@ -64,9 +71,7 @@ export class TimelineControls {
       e.status.textContent = `viewing the past: ${clockText(t)}${count}`;
     }
     e.status.classList.toggle("past", !live && t !== null);
-    const bounded = data && data.keptFrom !== null && data.keptFrom > 1;
-    const from = bounded && data.first && data.first.seq === data.keptFrom ? ` (${clockText(data.first.t)})` : "";
-    e.kept.textContent = bounded ? `history reaches back to seq ${data.keptFrom}${from}` : "";
+    e.kept.textContent = data?.first ? keptText(data.first, data.keptFrom) : "";
     e.live.hidden = live || !liveMachine;
     e.play.textContent = playing ? "❚❚" : "▶";
     e.play.title = playing ? "Pause (Space)" : "Play (Space)";

@@ -155,13 +155,6 @@ export class Painter {
   marks(g, data) {
     const { ctx } = this;
     const top = LAYOUT.axisH, h = LAYOUT.marksH;
-    ctx.fillStyle = COLOURS.run;
-    for (const run of data.runs) {
-      const x = Math.round(xOf(g, run.t));
-      if (x < LAYOUT.labelW || x > g.w) continue;
-      ctx.fillRect(x, top, 1, g.h - top);
-      ctx.fillText(`run ${run.run}`, x + 3, top + h / 2);
-    }
     const { ticks } = data;
     let lastX = -1;
     for (let i = lowerBound(ticks.t, g.v0, ticks.n); i < ticks.n && ticks.t[i] <= g.v1; i++) {
@@ -170,6 +163,13 @@ export class Painter {
       lastX = x;
       ctx.fillStyle = TICK_COLOURS[ticks.kind[i]];
       ctx.fillRect(x - 1, top + 2, 3, h - 4);
+    }
+    ctx.fillStyle = COLOURS.run;
+    for (const run of data.runs) {
+      const x = Math.round(xOf(g, run.t));
+      if (x < LAYOUT.labelW || x > g.w) continue;
+      ctx.fillRect(x, top, 1, g.h - top);
+      ctx.fillText(`run ${run.run}`, x + 3, top + h / 2);
     }
     ctx.fillStyle = COLOURS.muted;
     ctx.fillText("events", 6, top + h / 2);

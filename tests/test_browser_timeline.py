@@ -151,3 +151,17 @@ def test_a_speed_the_page_shows_is_selected_even_when_not_a_choice(page):
     build(page)
     page.evaluate("tl.showSpeed(3)")
     assert page.input_value("#tl-test select") == "3"
+
+
+def test_a_history_that_no_longer_reaches_the_first_event_says_how_far_back_it_reaches(page):
+    data = {**timeline_data(), "first": {"seq": 40, "t": T0}, "kept_from": 60}
+    build(page, data)
+    assert page.text_content("#tl-test .tl-kept") == (
+        "history reaches back to %s (seq 40); full detail from seq 60" % page.evaluate(
+            "async (t) => (await import('/timeline_draw.js')).clockText(t)", T0))
+
+
+def test_the_status_line_says_how_far_behind_the_past_shown_is(page):
+    build(page, behind=7, liveMachine=True)
+    assert page.text_content("#tl-test .tl-status") == "viewing the past: %s, 7 events behind" % page.evaluate(
+        "async (t) => (await import('/timeline_draw.js')).clockText(t)", T0 + SPAN)

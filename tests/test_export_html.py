@@ -264,3 +264,22 @@ def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_pag
         assert not live.errors
     finally:
         live.close()
+
+
+def test_next_transition_steps_into_the_nested_machine(file_page, recorded):
+    log, events = recorded
+    to_sub = seq_of(events, "transition", "/SM_ROOT", 60)  # the root's CHECK -> SUB after the 30th note
+    into_sub = seq_of(events, "start", "/SM_ROOT/SUB", 31)  # then SUB starts its 31st run
+    for seq in (to_sub, into_sub):
+        file_page.click('#timeline button[title^="Next transition"]')
+        at_instant(file_page, seq)
+    assert shown(file_page)["active"] == rebuilt(log, into_sub)["active"] == ["/SM_ROOT/SUB", "/SM_ROOT/SUB/A"]
+
+
+def test_play_runs_the_file_to_the_end_of_the_run(file_page, recorded):
+    log, events = recorded
+    last = events[-1]["seq"]
+    file_page.click("#timeline button.tl-play")
+    at_instant(file_page, last)
+    wait_for(lambda: not file_page.evaluate("fsmscope.instant.playing"), 5, what="the playhead to stop at the end")
+    assert {k: v for k, v in shown(file_page).items() if k in ("active", "containers")} == rebuilt(log, last)

@@ -1,0 +1,156 @@
+"""The page `fsmscope export LOG --html OUT.html` writes, opened from disk (file://) in Chromium with every
+request that is not file: or data: aborted: it shows a recorded run as the served dashboard
+(`fsmscope replay LOG --serve`) shows it, and as fsm.logfiles.log_reader.seek rebuilds it."""
+
+from __future__ import annotations
+
+import json
+import urllib.parse
+
+import pytest
+from browser_support import ACTIVE_LEAF
+from export_support import MARKUP, NAME, exported_run, seq_of
+from recording_support import replay_served
+from fsm.logfiles.log_reader import seek
+from fsm.observation.schema import state_id
+from server.testing.browser import open_page
+from server.testing.polling import wait_for
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    return exported_run(tmp_path_factory)
+
+
+def open_file(browser, path, seq: int):
+    """The exported page at event ``seq`` (its deep link), every request that is not file: or data: aborted
+    (``page.blocked`` lists them), the page's policy violations in ``window.violations``."""
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    page.set_default_timeout(10000)
+    page.errors, page.blocked = [], []
+    page.on("pageerror", lambda e: page.errors.append(str(e)))
+
+    def only_local(route):
+        if route.request.url.startswith(("file:", "data:")):
+            route.continue_()
+        else:
+            page.blocked.append(route.request.url)
+            route.abort()
+
+    page.route("**/*", only_local)
+    page.add_init_script("window.violations = []; document.addEventListener('securitypolicyviolation',"
+                         " (e) => window.violations.push(e.violatedDirective + ' ' + e.blockedURI));")
+    page.goto(path.as_uri() + "#m=%s&seq=%d" % (NAME, seq))
+    return at_instant(page, seq)
+
+
+def at_instant(page, seq: int):
+    """``page`` once it shows event ``seq``: the instant, the graph and the log row marked."""
+    page.wait_for_selector("#graph svg")
+    wait_for(lambda: page.evaluate("fsmscope.instant.seq") == seq
+             and page.evaluate("document.querySelector('#log .log-row.at')?.dataset.seq") == str(seq),
+             10, interval=0.05, what=lambda: "event %d shown; the page is at %r" % (seq, page.evaluate("fsmscope.instant")))
+    return page
+
+
+SHOWN = """(() => {
+    const s = fsmscope.status;
+    const row = document.querySelector('#log .log-row.at');
+    return {
+        active: s.activePaths().sort(),
+        containers: Object.fromEntries(Object.entries(s.containers).map(([p, c]) => [p, {userdata: c.userdata, changes: c.changes}])),
+        log_row: row && [row.dataset.seq, row.querySelector('.kind').textContent, row.querySelector('.msg').textContent],
+        userdata_rows: [...document.querySelectorAll('#userdata tr.ud-row')].map((r) => [r.dataset.key, r.className, r.querySelector('td.value').textContent]),
+    };
+})()"""
+
+
+def shown(page) -> dict:
+    """What the page shows of its instant: active states, userdata and changes, the log row marked, the userdata panel."""
+    data = page.evaluate(SHOWN)
+    data["graph_leaf"] = page.evaluate(ACTIVE_LEAF)
+    return data
+
+
+def rebuilt(log, seq: int) -> dict:
+    """What fsm.logfiles.log_reader.seek says of event ``seq``: active states, userdata and changes."""
+    status = seek(log, NAME, seq).status
+    return {"active": sorted(p + "/" + a for p, c in status.containers.items() for a in c["active"] if a != "None"),
+            "containers": {p: {"userdata": c["userdata"], "changes": c["changes"]} for p, c in status.containers.items()}}
+
+
+@pytest.fixture
+def file_page(browser, run):
+    """The exported page at the root's 30th userdata event (its note changed there)."""
+    page = open_file(browser, run.html, seq_of(run.events, "userdata", "/SM_ROOT", 30))
+    yield page
+    assert not page.errors
+    page.close()
+
+
+def test_the_page_shows_the_instant_that_log_reader_seek_rebuilds(file_page, run):
+    log, events = run.log, run.events
+    seq = seq_of(events, "userdata", "/SM_ROOT", 30)
+    page = shown(file_page)
+    expected = rebuilt(log, seq)
+    assert {k: page[k] for k in expected} == expected
+    assert page["graph_leaf"] == state_id("/SM_ROOT/CHECK")
+    assert page["log_row"][:2] == [str(seq), "userdata"]
+    assert [key for key, cls, _ in page["userdata_rows"] if "changed" in cls] == ["note"]
+
+
+def test_the_page_makes_no_request_and_breaks_none_of_its_policy(file_page):
+    assert file_page.blocked == []
+    assert file_page.evaluate("window.violations") == []
+
+
+def test_a_userdata_value_with_markup_shows_as_text(file_page):
+    value = file_page.text_content('#userdata tr.ud-row[data-key="note"] td.value')
+    assert value.startswith(json.dumps(MARKUP + " loop 30"))
+    assert file_page.query_selector_all("#userdata img, #userdata b, #userdata script") == []
+    assert file_page.evaluate("window.pwned") is None
+
+
+def test_clicking_a_log_row_shows_that_event(file_page, run):
+    log, events = run.log, run.events
+    seq = seq_of(events, "transition", "/SM_ROOT/SUB", 30)  # A -> B of the 30th loop
+    file_page.click('#log .log-row[data-seq="%d"]' % seq)
+    at_instant(file_page, seq)
+    assert shown(file_page)["active"] == rebuilt(log, seq)["active"] == ["/SM_ROOT/SUB", "/SM_ROOT/SUB/B"]
+    assert file_page.evaluate(ACTIVE_LEAF) == state_id("/SM_ROOT/SUB/B")
+
+
+@pytest.fixture
+def replay_url(run):
+    """The dashboard's address of `fsmscope replay LOG --serve` serving the same log, in a real process."""
+    with replay_served(run.log) as (url, _):
+        yield url
+
+
+def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_page, browser, replay_url, run):
+    seq = seq_of(run.events, "userdata", "/SM_ROOT", 30)
+    live = open_page(browser, replay_url + "#m=%s&seq=%d" % (urllib.parse.quote(NAME), seq))
+    try:
+        assert shown(at_instant(live, seq)) == shown(file_page)
+        assert not live.errors
+    finally:
+        live.close()
+
+
+def test_next_transition_steps_into_the_nested_machine(file_page, run):
+    log, events = run.log, run.events
+    to_sub = seq_of(events, "transition", "/SM_ROOT", 60)  # the root's CHECK -> SUB after the 30th note
+    into_sub = seq_of(events, "start", "/SM_ROOT/SUB", 31)  # then SUB starts its 31st run
+    for seq in (to_sub, into_sub):
+        file_page.click('#timeline button[title^="Next transition"]')
+        at_instant(file_page, seq)
+    assert shown(file_page)["active"] == rebuilt(log, into_sub)["active"] == ["/SM_ROOT/SUB", "/SM_ROOT/SUB/A"]
+
+
+def test_play_runs_the_file_to_the_end_of_the_run(file_page, run):
+    log, events = run.log, run.events
+    last = events[-1]["seq"]
+    file_page.click("#timeline button.tl-play")
+    at_instant(file_page, last)
+    wait_for(lambda: not file_page.evaluate("fsmscope.instant.playing"), 5, what="the playhead to stop at the end")
+    assert {k: v for k, v in shown(file_page).items() if k in ("active", "containers")} == rebuilt(log, last)

@@ -5,19 +5,14 @@ every endpoint answering for every machine."""
 from __future__ import annotations
 
 import json
-import os
-import re
-import signal
-import subprocess
-import sys
 
 import httpx
 import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 from websockets.sync.client import connect
 
-from browser_support import ROOT
 from event_support import ev, flat_root, run_of
+from recording_support import replay_served
 from server import cli
 from server_support import client, frames, stream
 
@@ -88,7 +83,7 @@ def endpoints_answer(base_url: str, token: str) -> None:
     assert machines.status_code == 200, machines.text
     for info in machines.json():
         name = info["name"]
-        for path in ("/status", "/structure", "/graph.svg"):
+        for path in ("/status", "/structure", "/graph.svg", "/timeline"):
             answer = http.get("/api/machines/%s%s" % (name, path))
             assert answer.status_code < 500, (name, path, answer.status_code, answer.text)
 
@@ -136,21 +131,5 @@ def test_hostile_events_in_a_log_never_break_replay_in_the_dashboard(tmp_path_fa
     events = [e for e in events if not (type(e.get("v")) is int and e["v"] > 1)]
     log = tmp_path_factory.mktemp("hostile") / "run.jsonl"
     log.write_text("\n".join(json.dumps(e) for e in run_of(flat_root("A", "B")) + events) + "\n")
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve", "--speed", "0",
-                             "--token", "hostile-token"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
-    try:
-        for line in proc.stderr:
-            found = re.search(r"(http://127\.0\.0\.1:\d+)/", line)
-            if found:
-                break
-        else:
-            pytest.fail("fsmscope replay --serve printed no URL")
-        for line in proc.stderr:
-            if "replayed" in line:
-                break
-        endpoints_answer(found.group(1), "hostile-token")
-        assert proc.poll() is None
-    finally:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(20)
+    with replay_served(log, "--token", "hostile-token") as (url, _):
+        endpoints_answer(url.split("/?")[0], "hostile-token")

@@ -32,6 +32,8 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import httpx  # noqa: E402
 from fsm.logfiles.log_reader import read_events  # noqa: E402
 from replay import REPEATS, generate, median_time  # noqa: E402  (bench/replay.py's 1M-event recording)
+import table  # noqa: E402
+from table import verdict  # noqa: E402
 from server.history import History  # noqa: E402
 from server.fanout import Feed  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
@@ -48,15 +50,13 @@ class Row:
 
 
 def print_table(title: str, rows: list[Row]) -> None:
-    results = [(row, median_time(row.measure)) for row in rows]
-    width = max(len(row.name) for row in rows)
-    print(title)
-    print("%-*s  %10s  %10s  %s" % (width, "measure", "target", "median", "result"))
-    print("-" * (width + 36))
-    for row, seconds in results:
-        target = "<= %g ms" % (row.target * 1000) if row.target is not None else ""
-        verdict = "" if row.target is None else ("met" if seconds <= row.target else "MISSED")
-        print("%-*s  %10s  %7.1f ms  %s" % (width, row.name, target, seconds * 1000, verdict))
+    cells = []
+    for row in rows:
+        seconds = median_time(row.measure)
+        target = "" if row.target is None else "<= %g ms" % (row.target * 1000)
+        met = None if row.target is None else seconds <= row.target
+        cells.append((row.name, target, "%.1f ms" % (seconds * 1000), verdict(met)))
+    table.print_table(title, cells)
 
 
 def serve(path: str) -> ServerThread:

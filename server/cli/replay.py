@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .serving import add_server_arguments, start_server, wait_for_interrupt
 
@@ -147,11 +147,31 @@ def replay_in_browser(args: argparse.Namespace) -> int:
     if not count:
         print("fsmscope replay: %s" % no_events(reader), file=sys.stderr)
         return EXIT_UNREADABLE
-    srv = start_server(args, hub=hub)
-    print("fsmscope: replaying %s at %s (%d events loaded; Ctrl-C stops)" % (args.log, srv.url, count),
-          file=sys.stderr, flush=True)
+    scene = pose_scene(hub)
     try:
-        wait_for_interrupt()
+        srv = start_server(args, hub=hub, **({} if scene is None else {"scene_url": scene.url,
+                                                                       "show_pose": scene.show_pose}))
+        print("fsmscope: replaying %s at %s (%d events loaded; Ctrl-C stops)" % (args.log, srv.url, count),
+              file=sys.stderr, flush=True)
+        try:
+            wait_for_interrupt()
+        finally:
+            srv.stop()
     finally:
-        srv.stop()
+        if scene is not None:
+            scene.stop()
     return 0
+
+
+def pose_scene(hub: Hub) -> Any:
+    """A 3D view that draws the recorded arm (no simulation runs) when the log recorded its pose, else None."""
+    pose = next((entry.status.pose for entry in hub.machines() if entry.status.pose is not None), None)
+    if pose is None:
+        return None
+    from sim.scene import start_pose_scene
+
+    try:
+        return start_pose_scene({"joints": pose["joints"], "bodies": pose["bodies"]})
+    except ValueError as exc:  # a pose of another robot than the demo's arm
+        print("fsmscope replay: no 3D view: %s" % exc, file=sys.stderr)
+        return None

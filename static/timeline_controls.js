@@ -3,7 +3,7 @@
 // call the same Timeline actions; the keys work anywhere in the page but in a text field.
 
 import { h } from "./dom.js";
-import { clockText } from "./timeline_draw.js";
+import { clockText } from "./clocktext.js";
 
 export const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 5, 10];
 export const ZOOM_STEP = 1.5;

@@ -4,6 +4,7 @@
 // visible rows and, per row, only the bands in the visible range are drawn, at most one per pixel
 // column; every name and label goes in with fillText.
 
+import { clockText } from "./clocktext.js";
 import { MANY, NO_LABEL, lowerBound } from "./timeline_data.js";
 
 export const LAYOUT = { axisH: 22, marksH: 16, rowH: 18, labelW: 190, padR: 12, indent: 12 };
@@ -29,14 +30,6 @@ export function xOf(g, t) {
 /** The time at x in a frame `g`. */
 export function tOf(g, x) {
   return g.v0 + ((x - LAYOUT.labelW) / (g.w - LAYOUT.labelW - LAYOUT.padR)) * (g.v1 - g.v0);
-}
-
-const pad = (n, width = 2) => String(n).padStart(width, "0");
-
-/** HH:MM:SS.mmm of a wall-clock time in seconds, local time. */
-export function clockText(t) {
-  const d = new Date(Math.round(t * 1000));
-  return `${pad(d.getHours())}:${pad(d.getMinutes())}:${pad(d.getSeconds())}.${pad(d.getMilliseconds(), 3)}`;
 }
 
 // Light enough for dark text; no grey (grey is "+" and "…").

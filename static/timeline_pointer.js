@@ -4,7 +4,8 @@
 // it; hovering names what is under the pointer in the canvas's title.
 
 import { NO_LABEL } from "./timeline_data.js";
-import { LAYOUT, clockText, rowsTop, tOf } from "./timeline_draw.js";
+import { clockText } from "./clocktext.js";
+import { LAYOUT, rowsTop, tOf } from "./timeline_draw.js";
 
 const CLICK_SLOP = 3; // px a press may move and still be a click
 const TICK_HIT = 4; // px either side of a tick

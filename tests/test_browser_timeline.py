@@ -158,10 +158,10 @@ def test_a_history_that_no_longer_reaches_the_first_event_says_how_far_back_it_r
     build(page, data)
     assert page.text_content("#tl-test .tl-kept") == (
         "history reaches back to %s (seq 40); full detail from seq 60" % page.evaluate(
-            "async (t) => (await import('/timeline_draw.js')).clockText(t)", T0))
+            "async (t) => (await import('/clocktext.js')).clockText(t)", T0))
 
 
 def test_the_status_line_says_how_far_behind_the_past_shown_is(page):
     build(page, behind=7, liveMachine=True)
     assert page.text_content("#tl-test .tl-status") == "viewing the past: %s, 7 events behind" % page.evaluate(
-        "async (t) => (await import('/timeline_draw.js')).clockText(t)", T0 + SPAN)
+        "async (t) => (await import('/clocktext.js')).clockText(t)", T0 + SPAN)

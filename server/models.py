@@ -199,7 +199,7 @@ class Timeline(BaseModel):
                   {"seq": 5, "t": 1700000001.5, "kind": "preempt", "text": "preempt requested of /SM_ROOT"}],
         "transitions": [[2, 1700000000.1], [3, 1700000000.2], [4, 1700000001.0], [6, 1700000002.3],
                         [7, 1700000002.4]],
-        "coarse": False}]})
+        "coarse": False, "history_from": 1}]})
 
     first: Optional[TimelinePoint] = Field(description="the machine's first event seen (null: none yet)")
     last: Optional[TimelinePoint] = Field(description="its last event")
@@ -212,6 +212,8 @@ class Timeline(BaseModel):
     transitions: list[tuple[int, float]] = Field(description="[seq, t] of every start/transition/terminate in the "
                                                  "range (at most 5000, evenly spread when there are more)")
     coarse: bool = Field(description="transitions were thinned, or the range reaches into coalesced detail")
+    history_from: Optional[int] = Field(None, description="the oldest seq whose instant can be shown (GET .../status?seq="
+                                        "): a machine with no recording keeps a bounded ring of recent events")
 
 
 class PreemptRequest(BaseModel):

@@ -104,7 +104,7 @@ export class Timeline {
   }
 
   toStart() {
-    if (this.data?.first) this.call("seek", { seq: this.data.first.seq });
+    if (this.data?.first) this.call("seek", { seq: Math.max(this.data.first.seq, this.data.historyFrom ?? 0) });
   }
 
   toEnd() {

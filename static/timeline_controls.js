@@ -11,8 +11,9 @@ export const ZOOM_STEP = 1.5;
 const button = (text, title, cls) => h("button", { type: "button", text, title, class: cls });
 
 /** How far back the server's history reaches (when not to seq 1) and from where its detail is whole. */
-function keptText(first, keptFrom) {
-  const reach = first.seq > 1 ? `history reaches back to ${clockText(first.t)} (seq ${first.seq})` : "";
+function keptText(first, keptFrom, historyFrom) {
+  const reach = historyFrom !== null && historyFrom > first.seq ? `history reaches back to seq ${historyFrom}`
+    : first.seq > 1 ? `history reaches back to ${clockText(first.t)} (seq ${first.seq})` : "";
   const coarse = keptFrom !== null && keptFrom > first.seq ? `full detail from seq ${keptFrom}` : "";
   return [reach, coarse].filter(Boolean).join("; ");
 }
@@ -71,7 +72,7 @@ export class TimelineControls {
       e.status.textContent = `viewing the past: ${clockText(t)}${count}`;
     }
     e.status.classList.toggle("past", !live && t !== null);
-    e.kept.textContent = data?.first ? keptText(data.first, data.keptFrom) : "";
+    e.kept.textContent = data?.first ? keptText(data.first, data.keptFrom, data.historyFrom) : "";
     e.live.hidden = live || !liveMachine;
     e.play.textContent = playing ? "❚❚" : "▶";
     e.play.title = playing ? "Pause (Space)" : "Play (Space)";

@@ -63,11 +63,12 @@ function buildTicks(ticks) {
 }
 
 export class TimelineData {
-  /** @param {object} resp the /timeline JSON: {first, last, kept_from, runs, bands, ticks, transitions, coarse} */
+  /** @param {object} resp the /timeline JSON: {first, last, kept_from, runs, bands, ticks, transitions, coarse, history_from} */
   constructor(resp = {}) {
     this.first = resp.first || null;
     this.last = resp.last || null;
     this.keptFrom = Number.isFinite(resp.kept_from) ? resp.kept_from : null;
+    this.historyFrom = Number.isFinite(resp.history_from) ? resp.history_from : null; // the oldest seq that can be shown
     this.runs = (Array.isArray(resp.runs) ? resp.runs : []).filter((r) => Number.isFinite(r.t));
     this.coarse = Boolean(resp.coarse);
     this.labels = []; // index -> label text

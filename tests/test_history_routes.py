@@ -206,3 +206,11 @@ def test_a_machine_of_another_process_answers_its_recent_past_from_memory(live_s
     for seq in (1, 1000, 1001, 2345):
         assert past(http.get("/api/machines/remote/status", params={"seq": seq}).json()) == \
             dict(past(seek(path, "recorded", seq).status.to_dict()), machine="remote")
+
+
+def test_without_a_recording_the_timeline_says_how_far_back_an_instant_can_be_shown(live_server, tmp_path, quiet):
+    run_recorded(live_server, tmp_path, 2 * fanout.RING_SIZE // 7, recording=False)
+    http = client(live_server)
+    first = http.get("/api/machines/m/history", params={"limit": 1}).json()["first_seq"]
+    timeline = http.get("/api/machines/m/timeline").json()
+    assert timeline["first"]["seq"] == 1 and timeline["history_from"] == first > 1

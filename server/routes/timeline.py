@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 from fastapi import APIRouter, HTTPException, Query
 from fastapi.concurrency import run_in_threadpool
@@ -12,7 +12,7 @@ from fastapi.responses import Response
 from fsm.observation.encoding import dumps
 
 from .. import models
-from .deps import AUTH, ERRORS, Machine
+from .deps import AUTH, ERRORS, HubDep, Machine
 
 router = APIRouter(dependencies=AUTH, tags=["machines"])
 
@@ -20,7 +20,7 @@ MAX_BUCKETS = 10_000
 
 
 @router.get("/api/machines/{name}/timeline", response_model=models.Timeline, responses=ERRORS)
-async def timeline(entry: Machine,
+async def timeline(entry: Machine, hub: HubDep,
                    since_t: Annotated[Optional[float], Query(description="from this time (default: the first "
                                                              "event's)")] = None,
                    until_t: Annotated[Optional[float], Query(description="to this time (default: the last "
@@ -33,5 +33,14 @@ async def timeline(entry: Machine,
             raise HTTPException(422, "%s must be a finite number of seconds, not %s" % (field, value))
     if since_t is not None and until_t is not None and since_t > until_t:
         raise HTTPException(422, "since_t (%r) is after until_t (%r)" % (since_t, until_t))
-    answer = await run_in_threadpool(entry.timeline.answer, since_t, until_t, buckets)
+    hub.fanout.flush()
+    answer = await run_in_threadpool(_answer, entry.timeline, entry.history.view(), since_t, until_t, buckets)
     return Response(dumps(answer), media_type="application/json")
+
+
+def _answer(index: Any, history: Any, since_t: float | None, until_t: float | None, buckets: int) -> dict:
+    """The timeline index's answer, and how far back the machine's history can show an instant (in a thread:
+    ``history`` is a view taken on the loop)."""
+    answer = index.answer(since_t, until_t, buckets)
+    answer["history_from"] = history.span()["first_seq"]
+    return answer

@@ -36,7 +36,6 @@ from .timeline import TimelineIndex
 MAX_MB = 64  # default size limit of a log: the whole run goes into the page, which a browser must hold
 KEYFRAME_EVERY = 1000  # events between two embedded statuses (a seek applies at most this many)
 TIMELINE_BUCKETS = 4000  # bands per container of the embedded whole-run timeline (zooming slices it)
-ENTRY = "app.js"
 SPECIFIER = "fsmscope/"
 SERVER_MODULES = {"api.js": "offline/api.js", "stream.js": "offline/stream.js"}  # replaced in the file
 OFFLINE_STYLE = "offline/offline.css"
@@ -127,12 +126,12 @@ def _data_url(text: str, media_type: str = "text/javascript") -> str:
     return "data:%s;charset=utf-8;base64,%s" % (media_type, base64.b64encode(text.encode()).decode())
 
 
-def import_map(root: str) -> dict[str, str]:
-    """Every module the page reaches from ENTRY, as a data: URL under its bare specifier, with its
-    relative imports rewritten to bare ones (and api.js, stream.js swapped for the offline ones,
-    except in the offline modules themselves)."""
+def import_map(root: str, entry: str) -> dict[str, str]:
+    """Every module the page reaches from ``entry`` (a path in ``root``), as a data: URL under its bare
+    specifier, with its relative imports rewritten to bare ones (and api.js, stream.js swapped for
+    the offline ones, except in the offline modules themselves)."""
     imports: dict[str, str] = {}
-    todo = [ENTRY]
+    todo = [entry]
     while todo:
         path = todo.pop()
         if SPECIFIER + path in imports:
@@ -185,16 +184,16 @@ def page(data: dict, title: str) -> str:
         styles.append(read(found.group(1)))
         return "<style>%s</style>" % styles[-1]
 
-    scripts: list[str] = []
-
-    def inline_modules(found: re.Match) -> str:
-        scripts[:] = [orjson.dumps({"imports": import_map(root)}).decode(), 'import "%s%s";' % (SPECIFIER, ENTRY)]
-        return '<script type="importmap">%s</script>\n<script type="module">%s</script>' % tuple(scripts)
-
     text = _substitute(_STYLESHEET, inline_style, read("index.html"), "stylesheet link")
     styles.append(read(OFFLINE_STYLE))
     text = text.replace("</head>", "<style>%s</style>\n</head>" % styles[-1], 1)
-    text = _substitute(_MODULE, inline_modules, text, "module script")
+    module = _MODULE.search(text)
+    if module is None:
+        raise ExportError("static/index.html has no module script")
+    entry = module.group(1)
+    scripts = [orjson.dumps({"imports": import_map(root, entry)}).decode(), 'import "%s%s";' % (SPECIFIER, entry)]
+    text = (text[:module.start()] + '<script type="importmap">%s</script>\n<script type="module">%s</script>'
+            % tuple(scripts) + text[module.end():])
     if any("</style" in s.lower() for s in styles) or any("</script" in s.lower() for s in scripts):
         raise ExportError("a stylesheet or the import map would end its element early")
     policy = ("default-src 'none'; script-src %s data:; style-src %s; img-src data:; base-uri 'none'; "

@@ -165,7 +165,10 @@ async function loadGraph() {
   try {
     if (await graph.load(key, () => api.graphSvg(name, expand))) queueRender();
   } catch (err) {
-    if (name === store.name) graph.clear("Could not draw the graph: " + (err.detail || err.message));
+    if (name !== store.name) return;
+    const text = "Could not draw the graph: " + (err.detail || err.message);
+    if (err.status === 404 && graph.key) notice(text, "warn"); // that drawing is missing: keep the one shown
+    else graph.clear(text);
   }
 }
 

@@ -97,23 +97,26 @@ AFTER_CLICK = """() => {
 
 
 @contextlib.contextmanager
-def replay_served(log: str) -> Iterator[str]:
-    """``fsmscope replay LOG --serve`` in its own process: yields the address it prints once the whole
-    log is loaded; Ctrl-C ends it."""
-    proc = subprocess.Popen(FSMSCOPE + ["replay", log, "--serve"], cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
+def served(arguments: list[str], says: str) -> Iterator[tuple[str, subprocess.Popen]]:
+    """``fsmscope ARGUMENTS`` in its own process: yields (the address it says on stderr once it serves, found
+    by the pattern ``says``, and the process); Ctrl-C ends it if it has not ended by itself."""
+    proc = subprocess.Popen(FSMSCOPE + arguments, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))  # even when run in the background
+
     def address() -> Optional[re.Match]:
         line = proc.stderr.readline()
         if not line:
-            raise RuntimeError("fsmscope replay --serve ended (exit %s) before serving" % proc.wait())
-        return re.search(r"replaying \S+ at (http://\S+)", line)
+            raise RuntimeError("fsmscope %s ended (exit %s) before serving" % (arguments[0], proc.wait()))
+        return re.search(says, line)
 
     try:
-        found = wait_for(address, 600, interval=0, what="fsmscope replay --serve to print its address")
+        found = wait_for(address, 600, interval=0, what="fsmscope %s to say its address" % arguments[0])
         threading.Thread(target=proc.stderr.read, daemon=True).start()  # whatever it says later
-        yield found.group(1)
+        yield found.group(1), proc
     finally:
-        os.killpg(proc.pid, signal.SIGINT)
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGINT)
         proc.wait(30)
 
 
@@ -122,7 +125,7 @@ def dashboard(log: str) -> Iterator[Any]:
     """A Chromium page showing the replay of ``log``, paused at its start, the probe installed."""
     from playwright.sync_api import sync_playwright
 
-    with replay_served(log) as url, sync_playwright() as pw:
+    with served(["replay", log, "--serve"], r"replaying \S+ at (http://\S+)") as (url, _), sync_playwright() as pw:
         browser = launch_chromium(pw)
         try:
             page = open_page(browser, url, timeout_ms=60000)

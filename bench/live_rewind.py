@@ -1,0 +1,210 @@
+"""Live rewind (issue 9): does a page looking back slow the live machine down? Target: while one page looks
+back on a live machine at 1,000 events/s, its transition rate drops <= 5 %.
+
+The machine is a two-state loop whose states compute (a Python loop of a fixed length, about 1 ms: no
+sleeping), so it runs at about 1,000 transitions (= events) a second with nothing else running and any
+CPU or GIL taken from it shows as a lower rate. It runs under ``fsmscope run`` (a real server, a real
+recording, the history beyond the ring read from it), in its own process. In rounds, each a window of
+``--seconds``: no page; one Chromium page showing the machine live; one page looking back (a click on
+the timeline's axis into the past, then playing from there at 1x, again every second). The rates are
+counted afterwards in the recording, over each window; medians of the rounds.
+
+On this 2-core machine the page's Chromium, the benchmark's driver and the machine's process share the
+cores: the drop includes Chromium's own CPU, the server answering the page (status at an instant,
+history pages, the timeline every second) and streaming it the live events. Run it under the browser
+lock:
+
+    flock /tmp/fsmscope-browser.lock .venv/bin/python bench/live_rewind.py [--rounds 3] [--seconds 5]
+"""
+
+import argparse
+import contextlib
+import json
+import os
+import random
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Any, Callable, Iterator
+
+# The repository first: run as a script, this folder comes first and its server.py would shadow the package.
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+from demo_cpu import TICKS, cpu_seconds  # noqa: E402
+from server.testing.browser import launch_chromium, open_page  # noqa: E402
+from table import print_table, verdict  # noqa: E402
+from timetravel_browser import axis, served  # noqa: E402
+
+WORK_SECONDS = 0.001  # of computing per state
+WARM_UP = 2.0  # s after the machine starts, and after a page opens
+SCRIPT = '''"""Two states that compute for a fixed number of steps, back and forth, until the file argv[1] exists."""
+import os
+import sys
+
+import fsm
+
+STOP, STEPS = sys.argv[1], int(sys.argv[2])
+fsm.set_loggers(*[lambda message: None] * 4)  # no line printed per transition
+
+
+def compute(ud):
+    total = 0
+    for i in range(STEPS):
+        total += i
+    return "stop" if os.path.exists(STOP) else "go"
+
+
+sm = fsm.StateMachine(outcomes=["done"])
+with sm:
+    fsm.StateMachine.add("A", fsm.CBState(compute, outcomes=["go", "stop"]), {"go": "B", "stop": "done"})
+    fsm.StateMachine.add("B", fsm.CBState(compute, outcomes=["go", "stop"]), {"go": "A", "stop": "done"})
+sm.execute()
+'''
+
+
+def steps_for(seconds: float) -> int:
+    """How many steps of the script's loop take ``seconds`` here (median of 21 timings of 100,000)."""
+    def once() -> float:
+        start = time.perf_counter()
+        total = 0
+        for i in range(100_000):
+            total += i
+        return time.perf_counter() - start
+    return int(100_000 * seconds / statistics.median(once() for _ in range(21)))
+
+
+def busy_cores() -> float:
+    """CPU seconds all cores have been busy so far (/proc/stat)."""
+    fields = [int(f) for f in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+    return (sum(fields) - fields[3] - fields[4]) / TICKS
+
+
+def thread_cpu(pid: int) -> float:
+    """User + system CPU seconds of the process's main thread alone (the machine runs the script there)."""
+    fields = Path("/proc/%d/task/%d/stat" % (pid, pid)).read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / TICKS
+
+
+def browser_cpu(machine_pid: int) -> dict[int, float]:
+    """CPU seconds of each of this process and its children but the machine's: Chromium, Playwright's
+    driver and this benchmark driving them."""
+    parents = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        with contextlib.suppress(OSError, IndexError):
+            parents[int(stat.parent.name)] = int(stat.read_text().rsplit(")", 1)[1].split()[1])
+    family, found = {os.getpid()}, True
+    while found:
+        found = {pid for pid, parent in parents.items() if parent in family and pid not in family | {machine_pid}}
+        family |= found
+    seconds = {}
+    for pid in family:
+        with contextlib.suppress(OSError):
+            seconds[pid] = cpu_seconds(pid)
+    return seconds
+
+
+class Window:
+    """One measured stretch: its wall-clock times, and the CPU (share of one core) of the machine's thread,
+    of its process's other threads (the server), of the browser and of all cores."""
+
+    def __init__(self, condition: str, pid: int, seconds: float, during: Callable[[float], None]) -> None:
+        self.condition = condition
+        meters = {"machine": lambda: {pid: thread_cpu(pid)}, "process": lambda: {pid: cpu_seconds(pid)},
+                  "browser": lambda: browser_cpu(pid), "all": lambda: {0: busy_cores()}}
+        before, self.t0 = {name: meter() for name, meter in meters.items()}, time.time()
+        during(self.t0 + seconds)
+        self.t1 = time.time()
+        self.cpu = {}
+        for name, meter in meters.items():  # the processes running at the end (a page closed before it is not)
+            self.cpu[name] = sum(s - before[name].get(k, 0.0) for k, s in meter().items()) / (self.t1 - self.t0)
+        self.cpu["server"] = self.cpu.pop("process") - self.cpu["machine"]
+        self.rate = 0.0
+
+
+def idle_until(end: float) -> None:
+    time.sleep(max(0.0, end - time.time()))
+
+
+def looking_back(page: Any, rng: random.Random) -> Callable[[float], None]:
+    """Every second: a click on the timeline's axis at a random point of the run's first 80 %, then play."""
+    def drive(end: float) -> None:
+        while time.time() < end:
+            x0, x1, y = axis(page)
+            page.mouse.click(x0 + rng.uniform(0.05, 0.8) * (x1 - x0), y)
+            page.wait_for_function("() => window.fsmscope.instant.past")
+            page.keyboard.press("Space")
+            idle_until(min(end, time.time() + 1.0))
+        if not page.evaluate("() => window.fsmscope.instant.past"):
+            raise RuntimeError("the page went back to live while looking back")
+    return drive
+
+
+@contextlib.contextmanager
+def page_on(browser: Any, url: str) -> Iterator[Any]:
+    page = open_page(browser, url, timeout_ms=60000)
+    try:
+        page.wait_for_selector("#timeline canvas")
+        time.sleep(WARM_UP)
+        yield page
+        if page.errors:
+            raise RuntimeError("the page failed: %s" % page.errors)
+    finally:
+        page.close()
+
+
+def measure(rounds: int, seconds: float, steps: int, tmp: str) -> list[Window]:
+    from playwright.sync_api import sync_playwright
+
+    script, log, stop = (os.path.join(tmp, name) for name in ("computing_loop.py", "run.jsonl", "stop"))
+    Path(script).write_text(SCRIPT)
+    rng = random.Random(9)
+    windows = []
+    with served(["run", "--exit", "--record", log, script, stop, str(steps)], r"dashboard at (http://\S+)") \
+            as (url, proc), sync_playwright() as pw:
+        browser = launch_chromium(pw)
+        time.sleep(WARM_UP)
+        for _ in range(rounds):
+            windows.append(Window("no page", proc.pid, seconds, idle_until))
+            with page_on(browser, url) as page:
+                windows.append(Window("one page, live", proc.pid, seconds, idle_until))
+            with page_on(browser, url) as page:
+                windows.append(Window("one page looking back", proc.pid, seconds, looking_back(page, rng)))
+        browser.close()
+        Path(stop).touch()
+        proc.wait(60)
+    with open(log) as recording:
+        times = [e["t"] for e in map(json.loads, recording) if e.get("kind") == "transition"]
+    for w in windows:
+        w.rate = sum(w.t0 <= t <= w.t1 for t in times) / (w.t1 - w.t0)
+    return windows
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--seconds", type=float, default=5.0, help="each window")
+    args = parser.parse_args()
+    steps = steps_for(WORK_SECONDS)
+    with tempfile.TemporaryDirectory(prefix="fsmscope-bench-") as tmp:
+        windows = measure(args.rounds, args.seconds, steps, tmp)
+    conditions = list(dict.fromkeys(w.condition for w in windows))
+    rows = []
+    base = None
+    for c in conditions:
+        mine = [w for w in windows if w.condition == c]
+        rate = statistics.median(w.rate for w in mine)
+        cpu = {name: statistics.median(w.cpu[name] for w in mine) * 100 for name in mine[0].cpu}
+        base = base or rate
+        targeted = c == "one page looking back"
+        rows.append(("%s: CPU %% of a core: machine %.0f, server %.0f, browser %.0f; all %d cores %.0f"
+                     % (c, cpu["machine"], cpu["server"], cpu["browser"], os.cpu_count(), cpu["all"]),
+                     "<= 5 % lower" if targeted else "", "%.0f/s (%+.1f %%)" % (rate, (rate / base - 1) * 100),
+                     verdict(rate >= 0.95 * base) if targeted else ""))
+    print_table("fsmscope live rewind: transitions/s of a machine computing ~%g ms a state, %d rounds of %g s"
+                % (WORK_SECONDS * 1000, args.rounds, args.seconds), rows)
+
+if __name__ == "__main__":
+    main()

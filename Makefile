@@ -37,6 +37,8 @@ bench: install
 	$(PY) bench/runtime.py
 	$(PY) bench/replay.py
 	$(PY) bench/timetravel.py
+	$(PY) bench/timetravel_browser.py
+	$(PY) bench/live_rewind.py
 	$(PY) bench/server.py
 	$(PY) bench/graph.py
 	$(PY) bench/sim.py

@@ -27,16 +27,16 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any, Callable, Iterator
+from typing import Any, Callable
 
 # The repository first: run as a script, this folder comes first and its server.py would shadow the package.
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from demo_cpu import TICKS, cpu_seconds  # noqa: E402
-from server.testing.browser import launch_chromium, open_page  # noqa: E402
+from server.testing.browser import launch_chromium  # noqa: E402
 from table import print_table, verdict  # noqa: E402
-from timetravel_browser import axis, served  # noqa: E402
+from timetravel_browser import axis, page_of, served  # noqa: E402
 
 WORK_SECONDS = 0.001  # of computing per state
 WARM_UP = 2.0  # s after the machine starts, and after a page opens
@@ -142,19 +142,6 @@ def looking_back(page: Any, rng: random.Random) -> Callable[[float], None]:
     return drive
 
 
-@contextlib.contextmanager
-def page_on(browser: Any, url: str) -> Iterator[Any]:
-    page = open_page(browser, url, timeout_ms=60000)
-    try:
-        page.wait_for_selector("#timeline canvas")
-        time.sleep(WARM_UP)
-        yield page
-        if page.errors:
-            raise RuntimeError("the page failed: %s" % page.errors)
-    finally:
-        page.close()
-
-
 def measure(rounds: int, seconds: float, steps: int, tmp: str) -> list[Window]:
     from playwright.sync_api import sync_playwright
 
@@ -168,9 +155,11 @@ def measure(rounds: int, seconds: float, steps: int, tmp: str) -> list[Window]:
         time.sleep(WARM_UP)
         for _ in range(rounds):
             windows.append(Window("no page", proc.pid, seconds, idle_until))
-            with page_on(browser, url) as page:
+            with page_of(browser, url):
+                time.sleep(WARM_UP)
                 windows.append(Window("one page, live", proc.pid, seconds, idle_until))
-            with page_on(browser, url) as page:
+            with page_of(browser, url) as page:
+                time.sleep(WARM_UP)
                 windows.append(Window("one page looking back", proc.pid, seconds, looking_back(page, rng)))
         browser.close()
         Path(stop).touch()

@@ -128,15 +128,26 @@ def dashboard(log: str) -> Iterator[Any]:
     with served(["replay", log, "--serve"], r"replaying \S+ at (http://\S+)") as (url, _), sync_playwright() as pw:
         browser = launch_chromium(pw)
         try:
-            page = open_page(browser, url, timeout_ms=60000)
-            page.wait_for_function("() => window.fsmscope.instant.seq !== null")
-            page.wait_for_selector("#timeline canvas")
-            page.evaluate(PROBE)
-            yield page
-            if page.errors:
-                raise RuntimeError("the page failed: %s" % page.errors)
+            with page_of(browser, url) as page:
+                page.wait_for_function("() => window.fsmscope.instant.seq !== null")
+                page.evaluate(PROBE)
+                yield page
         finally:
             browser.close()
+
+
+@contextlib.contextmanager
+def page_of(browser: Any, url: str) -> Iterator[Any]:
+    """A new page of ``browser`` showing the dashboard at ``url`` with its timeline; closed after, and
+    failing if the page met an uncaught error."""
+    page = open_page(browser, url, timeout_ms=60000)
+    try:
+        page.wait_for_selector("#timeline canvas")
+        yield page
+        if page.errors:
+            raise RuntimeError("the page failed: %s" % page.errors)
+    finally:
+        page.close()
 
 
 def axis(page: Any) -> tuple[float, float, float]:

@@ -10,6 +10,7 @@ const WINDOW_BEFORE = 400; // events of the log shown before the instant
 const WINDOW_AFTER = 100; // and after it (greyed: not happened yet at the instant)
 const AHEAD = 1000; // events fetched ahead while playing
 const MAX_GAP = 2; // seconds of recorded time: a longer quiet stretch plays in this long
+const WINDOW_EVERY_MS = 250; // while playing, the log around the instant is redrawn this often
 
 export class Playhead {
   /**
@@ -98,6 +99,8 @@ export class Playhead {
     this.playing = true;
     this._clock = this.t;
     this._tick = null;
+    this._played = []; // events played since the log was last redrawn
+    this._windowAt = 0;
     this._fill();
     requestAnimationFrame((now) => this._frame(now));
     this.handlers.changed();
@@ -219,9 +222,13 @@ export class Playhead {
     let applied = 0;
     while (applied < ahead.length && ahead[applied].t <= this._clock) this.status.apply(ahead[applied++]);
     if (applied) {
-      const done = ahead.splice(0, applied);
-      const events = this.window ? this.window.events.concat(done).slice(-WINDOW_BEFORE) : done;
-      this.window = { events, seq: this.seq };
+      this._played.push(...ahead.splice(0, applied));
+      if (now - this._windowAt >= WINDOW_EVERY_MS) { // the log follows a few times a second, not every frame
+        this._windowAt = now;
+        const events = (this.window ? this.window.events.concat(this._played) : this._played).slice(-WINDOW_BEFORE);
+        this._played = [];
+        this.window = { events, seq: this.seq };
+      }
       this.handlers.changed();
     }
     if (ahead.length < AHEAD / 4) this._fill();

@@ -122,6 +122,22 @@ def test_the_arm_is_drawn_where_the_log_put_it_at_the_instant(browser, replayed,
     page.close()
 
 
+def test_dragging_on_the_timeline_shows_the_state_at_the_instant_dragged_to(browser, replayed, demo_log, events):
+    page = open_at(browser, replayed[0], events[0]["seq"])
+    box = page.locator(".tl-canvas").bounding_box()
+    left = box["x"] + page.evaluate("async () => (await import('/timeline_draw.js')).LAYOUT.labelW") + 5
+    y = box["y"] + 10  # the time axis
+    page.mouse.move(left, y)
+    page.mouse.down()
+    page.mouse.move(left + (box["x"] + box["width"] - left) * 0.45, y, steps=12)
+    page.mouse.up()
+    wait_for(lambda: page.evaluate("window.fsmscope.instant.seq") > events[30]["seq"], timeout=10,
+             what="the drag to move the instant into the run")
+    shown = shown_status(page)  # whatever instant the drag has reached: the state rebuilt there
+    assert active_paths(shown) == active_paths(rebuilt(demo_log, shown["last_seq"]))
+    page.close()
+
+
 def test_stepping_forward_and_back_crosses_a_nested_transition(browser, replayed, demo_log, events):
     pick_ends = next(e for e in events if e["kind"] == "terminate" and e["path"] == "/SM_ROOT/TASK/PICK")
     after = next(e for e in events if e["seq"] > pick_ends["seq"] and e["kind"] in STEPPED)

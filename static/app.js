@@ -1,6 +1,7 @@
 // Wiring: the machine shown (store.js), fed by its stream, drawn by the graph and the panels at the
 // instant the playhead (timetravel.js) says, live or past; the picker (machines.js), controls
-// (controls.js), depth (depth.js), notices and badge around it.
+// (controls.js), depth (depth.js), notices and badge around it. About 300 lines, one piece on
+// purpose: it is the one place where the page's parts meet, and it holds no logic of its own.
 
 import { api } from "./api.js";
 import { showBadge } from "./badge.js";

@@ -264,8 +264,10 @@ def look_back(page) -> int:
 
 def test_looking_back_at_a_live_machine_says_how_far_behind_it_is(live_page):
     look_back(live_page)
-    text = live_page.text_content(".tl-status")
-    assert text.startswith("viewing the past: ") and "events behind" in text
+    said = live_page.wait_for_function(  # drawn at the next frame after the instant changed
+        "() => { const t = document.querySelector('.tl-status').textContent;"
+        " return t.startsWith('viewing the past: ') && t; }").json_value()
+    assert " events behind" in said
 
 
 def test_a_live_machine_runs_on_while_the_page_looks_back(live_page):
@@ -281,4 +283,4 @@ def test_back_to_live_shows_the_machine_as_it_is_now(live_page):
     live_page.click("button.tl-live")
     wait_for(lambda: not live_page.evaluate("window.fsmscope.instant.past"), timeout=5, what="live again")
     assert live_page.evaluate("window.fsmscope.status === window.fsmscope.liveStatus")
-    assert live_page.is_hidden("button.tl-live")
+    live_page.wait_for_selector("button.tl-live", state="hidden")

@@ -32,6 +32,7 @@ from typing import Any, Callable
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 
+from .history import status_answer
 from .timeline import TimelineIndex
 
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
@@ -141,12 +142,10 @@ class Feed:
             idle.clear()
 
     def status_dict(self) -> dict:
-        """``Status.to_dict()``, consistent (machine threads apply events to it concurrently), with the
-        states a pending preempt still waits on."""
+        """GET .../status's answer for the Status now (``history.status_answer``), consistent: machine
+        threads apply events to it concurrently."""
         with self.lock:
-            data = self.status.to_dict()
-            data["preempt_waiting_on"] = self.status.preempt_waiting_on()
-        return data
+            return status_answer(self.status)
 
     def snapshot(self) -> tuple[int, str]:
         """(last_seq, the snapshot frame): built once per state, shared by every client that needs it."""

@@ -138,8 +138,8 @@ class LogHistory:
         """The same events, newest first: the log is read forward one stretch between marks at a time."""
         with self._lock:
             self._prepare(seq=until)
-            marks = list(self._marks)
-        k = bisect.bisect_left([m.seq for m in marks], until)
+            marks, seqs = list(self._marks), list(self._mark_seqs)
+        k = bisect.bisect_left(seqs, until)
         for j in range(k, -1, -1):
             start = marks[j - 1].offset if j else 0
             end = marks[j].offset if j < len(marks) else None

@@ -227,7 +227,7 @@ function stateMenu(path, x, y) {
 
 function updateTopBar() {
   controls.update();
-  showRunState($("run-state"), store.status && shownStatus(), machines.current());
+  showRunState($("run-state"), shownStatus(), machines.current());
 }
 
 function updateBadge() {
@@ -243,7 +243,7 @@ function queueRender() {
 
 /** The status of the instant shown: the playhead's when it looks back, else the stream's present. */
 function shownStatus() {
-  return playhead.past && playhead.status ? playhead.status : store.status;
+  return playhead.past ? playhead.status : store.status;
 }
 
 /** The timeline's playhead, and the page framed as looking back when it does. */

@@ -26,6 +26,11 @@ function searchedWords(ev) {
   return words.filter((w) => typeof w === "string");
 }
 
+/** An event's transcript `line` and the text the filter searches for it. */
+function described(ev, line) {
+  return { line, text: [...searchedWords(ev), line.text].join("\n").toLowerCase() };
+}
+
 /** The kinds the log shows: a checkbox per kind in a <details> popover, closed by Escape or a click elsewhere. */
 class KindFilter {
   constructor(details, changed) {
@@ -123,8 +128,7 @@ export class EventLog {
   _describe(ev) {
     let d = this.described.get(ev);
     if (!d) {
-      const line = this.transcript.row(ev);
-      d = { line, text: [...searchedWords(ev), line.text].join("\n").toLowerCase() };
+      d = described(ev, this.transcript.row(ev));
       this.described.set(ev, d);
     }
     return d;
@@ -173,13 +177,13 @@ export class EventLog {
     if (stick) this.host.scrollTop = this.host.scrollHeight;
   }
 
-  /** Looking back: show `window` ({events, seq}, the events around the instant seq), the instant's
+  /** Looking back: show `past` ({events, seq}, the events around the instant seq), the instant's
    * row marked and scrolled to, later rows greyed; null: back to the newest events. */
-  showPast(window) {
+  showPast(past) {
     const wasFrozen = this.frozen;
-    this.frozen = window !== null;
-    if (window === this.past && wasFrozen === this.frozen) return;
-    this.past = window;
+    this.frozen = past !== null;
+    if (past === this.past && wasFrozen === this.frozen) return;
+    this.past = past;
     this.redraw();
   }
 
@@ -212,8 +216,7 @@ export class EventLog {
     const rows = [];
     let at = null;
     for (const ev of events) {
-      const line = transcript.row(ev);
-      this.described.set(ev, { line, text: [...searchedWords(ev), line.text].join("\n").toLowerCase() });
+      this.described.set(ev, described(ev, transcript.row(ev)));
       if (!this._matches(ev)) continue;
       const row = this._row(ev);
       if (ev.seq > seq) row.classList.add("later");

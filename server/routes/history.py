@@ -56,7 +56,6 @@ async def status(hub: HubDep, entry: Machine,
         raise HTTPException(422, "t must be a finite number of seconds, not %s" % t)
     if seq is None and t is None:
         data = entry.status_dict()
-        data.pop("structure", None)
     else:
         data = await answer(hub, entry, lambda view: view.status_at(seq, t))
     return Response(dumps(data), media_type="application/json")

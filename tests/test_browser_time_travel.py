@@ -110,6 +110,12 @@ def test_the_graph_lights_the_states_active_at_the_instant(browser, replayed, ev
     page.close()
 
 
+def test_the_run_pill_says_the_state_of_the_instant_shown(browser, replayed, events):
+    page = open_at(browser, replayed[0], first_transition(events, "/SM_ROOT/TASK/PICK")["seq"])
+    page.wait_for_function("document.getElementById('run-state').textContent === 'running'")
+    page.close()
+
+
 def test_the_arm_is_drawn_where_the_log_put_it_at_the_instant(browser, replayed, events):
     srv, scene = replayed
     carried = first_transition(events, "/SM_ROOT/TASK/PLACE")["seq"]  # TRANSPORT done: the cube in the air

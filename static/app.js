@@ -35,7 +35,6 @@ let timelineRange = { since_t: null, until_t: null }; // the range the timeline 
 const playhead = new Playhead(api, {
   changed: () => queueRender(),
   failed: (err) => notice("Could not show that instant: " + (err.detail || err.message), "warn"),
-  structure: () => store.status?.structure ?? null,
 });
 
 const graph = new GraphView($("graph"), {

@@ -36,8 +36,9 @@ export function runState(s, entry) {
 
 /** The pill that says the run state of status `s` (null: none yet) of the machine of `entry`. */
 export function showRunState(pill, s, entry) {
-  const state = s?.structure ? runState(s, entry) : "idle";
-  let text = s?.structure ? state : "—";
+  const known = Boolean(s?.root_path); // its structure has been seen (a past status from the server omits the tree)
+  const state = known ? runState(s, entry) : "idle";
+  let text = known ? state : "—";
   if (state === "failed") text = "failed: " + (s.error.exc_type || "error");
   if (state === "done") text = "finished: " + s.outcome;
   if (pill.textContent !== text) pill.textContent = text;

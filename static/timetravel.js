@@ -15,8 +15,7 @@ const WINDOW_EVERY_MS = 250; // while playing, the log around the instant is red
 export class Playhead {
   /**
    * @param {object} api {statusAt(name, {seq}|{t}), history(name, params)}: the server's answers
-   * @param {object} handlers {changed(): the instant, its status or its window changed; failed(err);
-   *   structure(): the machine's structure, which the server's past statuses leave out}
+   * @param {object} handlers {changed(): the instant, its status or its window changed; failed(err)}
    */
   constructor(api, handlers) {
     this.api = api;
@@ -137,8 +136,7 @@ export class Playhead {
         this._target = null;
         const data = await this.api.statusAt(this.name, target);
         if (generation !== this._generation) return;
-        // The server's answer leaves the structure out (GET .../status): the page's own is the machine's.
-        this.status = Status.fromDict({ machine: this.name, structure: this.handlers.structure(), ...data });
+        this.status = Status.fromDict({ machine: this.name, ...data });
         this.past = true;
         this.handlers.changed();
       }

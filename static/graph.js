@@ -1,10 +1,12 @@
 // The machine graph: the server's Graphviz SVG (one layout per structure + expand set),
 // sanitized and inlined; status only toggles CSS classes on the stable ids of docs/api.md
 // (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
-// the layout never moves when only the status changes. Pan (drag) and zoom (wheel) act on the
-// SVG's viewBox. One module (about 300 lines): loading, marking and pan/zoom all act on the same
+// the layout never moves when only the status changes; the marks are drawn by an overlay of copies
+// (graph_marks.js), so the drawing itself never repaints. Pan (drag) and zoom (wheel) act on the
+// viewBox of both. One module (about 300 lines): loading, marking and pan/zoom all act on the same
 // inlined SVG and its element index.
 
+import { GraphMarks } from "./graph_marks.js";
 import { containerId, outcomeId, stateId } from "./schema.js";
 import { parentPath } from "./status.js";
 
@@ -60,6 +62,7 @@ export class GraphView {
     this.host = host;
     this.handlers = handlers;
     this.svg = null;
+    this.marks = null; // the overlay that draws the classes set on this.svg's elements
     this.base = null; // the layout's own viewBox {x, y, w, h}
     this.vb = null;
     this.key = null; // what the current SVG was laid out for
@@ -90,16 +93,18 @@ export class GraphView {
     svg.removeAttribute("style");
     svg.classList.add("graph-svg");
     this.svg = svg;
+    this.marks = new GraphMarks(svg);
     this.base = base;
     this.key = key;
     this.classed = new Map();
-    this.host.replaceChildren(svg);
+    this.host.replaceChildren(svg, this.marks.svg);
     this.fit();
     return true;
   }
 
   clear(message) {
     this.svg = null;
+    this.marks = null;
     this.key = null;
     this.classed = new Map();
     const p = document.createElement("p");
@@ -168,6 +173,8 @@ export class GraphView {
       active.add(el.id);
       if (!deepest || path.length > deepest.path.length) deepest = { path, el };
     }
+    // Measured before anything is written, so reading the layout forces no style or layout.
+    const pan = this.follow && deepest ? this._panFor(deepest.el) : null;
     for (const path of view.running) {
       if (this.el(containerId(path))) active.add(containerId(path));
     }
@@ -186,26 +193,32 @@ export class GraphView {
       if (el) selected.add(el.id);
     }
     this._setClass("selected", selected);
-    if (this.follow && deepest) this.reveal(deepest.el);
+    this.marks.show(new Set([...this.classed.values()].flatMap((ids) => [...ids])));
+    if (pan) this._setViewBox(pan);
   }
 
   /** Pan (never zoom) so that `el` is inside the view, when it is not already. */
   reveal(el) {
-    if (!this.svg || !el) return;
+    const pan = this.svg && el ? this._panFor(el) : null;
+    if (pan) this._setViewBox(pan);
+  }
+
+  /** The viewBox that brings `el` into the view, or null when it is in already (or cannot be). */
+  _panFor(el) {
     const box = el.getBoundingClientRect();
     const view = this.host.getBoundingClientRect();
-    if (!view.width || !view.height) return;
+    if (!view.width || !view.height) return null;
     const margin = 2;
-    if (box.width > view.width - 2 * margin || box.height > view.height - 2 * margin) return;
+    if (box.width > view.width - 2 * margin || box.height > view.height - 2 * margin) return null;
     const inside = box.left >= view.left + margin && box.right <= view.right - margin
       && box.top >= view.top + margin && box.bottom <= view.bottom - margin;
-    if (inside) return;
+    if (inside) return null;
     const ctm = this.svg.getScreenCTM();
-    if (!ctm) return;
+    if (!ctm) return null;
     const k = ctm.a || 1;
     const dx = (box.left + box.width / 2 - (view.left + view.width / 2)) / k;
     const dy = (box.top + box.height / 2 - (view.top + view.height / 2)) / k;
-    this._setViewBox({ ...this.vb, x: this.vb.x + dx, y: this.vb.y + dy });
+    return { ...this.vb, x: this.vb.x + dx, y: this.vb.y + dy };
   }
 
   /** Show the whole graph, but never larger than MAX_FIT_SCALE pixels per SVG unit (a tiny graph stays small). */
@@ -244,7 +257,10 @@ export class GraphView {
 
   _setViewBox(vb) {
     this.vb = vb;
-    if (this.svg) this.svg.setAttribute("viewBox", `${vb.x} ${vb.y} ${vb.w} ${vb.h}`);
+    if (!this.svg) return;
+    const text = `${vb.x} ${vb.y} ${vb.w} ${vb.h}`;
+    this.svg.setAttribute("viewBox", text);
+    this.marks.setViewBox(text);
   }
 
   _target(event) {

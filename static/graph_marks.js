@@ -1,0 +1,82 @@
+// The graph's marks (active, reached, last edge, failed, selected) drawn over the drawing, so the
+// drawing itself never repaints when the instant changes. The drawing's elements keep their
+// classes (the contract of docs/api.md: `#graph g.node.active` is the drawn state), but no style
+// reads them; each marked element gets a copy in an overlay <svg> with the same viewBox, placed
+// by its ancestors' transforms, and only the copies are styled. Their classes are the element's
+// with "m-" in front, so no selector meant for the drawing ever matches a copy.
+//
+// Why: Chromium repaints and re-layerizes a whole SVG when any of its elements changes style; at
+// 606 states (1,400 elements) that was 15 ms of every frame (bench/timetravel_browser.py), and
+// the overlay holds a few elements.
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+const KINDS = ["cluster", "edge", "node"]; // the overlay's layers, drawn in this order
+
+/** The transform from an element's own coordinates to its <svg>'s user space (read from the
+ * attributes: no layout). */
+function placement(el, root) {
+  let matrix = new DOMMatrix();
+  for (let e = el; e && e !== root; e = e.parentElement) {
+    const list = e.transform?.baseVal;
+    if (!list) continue;
+    let own = new DOMMatrix();
+    for (let i = 0; i < list.numberOfItems; i++) own = own.multiply(DOMMatrix.fromMatrix(list.getItem(i).matrix));
+    matrix = own.multiply(matrix);
+  }
+  return matrix;
+}
+
+/** What a copy draws: a node's or an edge's shapes and label; a cluster's frame and label only (its
+ * children are drawn, and marked, on their own). */
+function drawnParts(el, kind) {
+  const parts = kind === "cluster" ? el.querySelectorAll(":scope > polygon.frame, :scope > text") : el.children;
+  return [...parts].filter((part) => part.localName !== "title").map((part) => {
+    const copy = part.cloneNode(true);
+    for (const named of [copy, ...copy.querySelectorAll("[id]")]) named.removeAttribute("id");
+    return copy;
+  });
+}
+
+export class GraphMarks {
+  /** @param {SVGSVGElement} drawing the inlined drawing the marks go over */
+  constructor(drawing) {
+    this.drawing = drawing;
+    this.svg = document.createElementNS(SVG_NS, "svg");
+    for (const [name, value] of [["class", "graph-marks"], ["aria-hidden", "true"], ["width", "100%"],
+      ["height", "100%"], ["preserveAspectRatio", drawing.getAttribute("preserveAspectRatio")]]) {
+      this.svg.setAttribute(name, value);
+    }
+    this.layers = new Map(KINDS.map((kind) => [kind, this.svg.appendChild(document.createElementNS(SVG_NS, "g"))]));
+    this.copies = new Map(); // drawing element id -> its copy
+  }
+
+  setViewBox(text) {
+    this.svg.setAttribute("viewBox", text);
+  }
+
+  /** Draw a copy of exactly the elements whose ids are in `ids`, with their current classes; only
+   * what changed is touched. */
+  show(ids) {
+    for (const [id, copy] of this.copies) {
+      if (!ids.has(id)) {
+        copy.remove();
+        this.copies.delete(id);
+      }
+    }
+    for (const id of ids) {
+      const el = document.getElementById(id);
+      if (!el || !this.drawing.contains(el)) continue;
+      const classes = [...el.classList].map((name) => "m-" + name).join(" ");
+      let copy = this.copies.get(id);
+      if (!copy) {
+        const kind = KINDS.find((k) => el.classList.contains(k)) || "node";
+        copy = document.createElementNS(SVG_NS, "g");
+        copy.setAttribute("transform", placement(el, this.drawing).toString());
+        copy.append(...drawnParts(el, kind));
+        this.layers.get(kind).append(copy);
+        this.copies.set(id, copy);
+      }
+      if (copy.getAttribute("class") !== classes) copy.setAttribute("class", classes);
+    }
+  }
+}

@@ -196,6 +196,7 @@ export class EventLog {
   redraw() {
     this.pending = [];
     this.needle = this.controls.text.value.trim().toLowerCase();
+    this.host.classList.toggle("past", this.past !== null);
     if (this.past) {
       this._drawPast();
       return;
@@ -228,11 +229,22 @@ export class EventLog {
     this.selectedRow = null;
     this.controls.count.textContent = `event ${seq}`;
     this.stick = false;
-    if (at) { // centred in the log, without scrolling the page around it
-      const row = at.getBoundingClientRect();
-      const box = this.host.getBoundingClientRect();
-      this.host.scrollTop += row.top - box.top - box.height / 2;
+    if (at) {
+      this._centre(at);
+      // The rows now in view get their real heights at the next frame (those out of view are
+      // estimated, style.css): centre again then, unless the user scrolled meanwhile.
+      const scrolled = this.host.scrollTop;
+      requestAnimationFrame(() => {
+        if (at.isConnected && this.host.scrollTop === scrolled) this._centre(at);
+      });
     }
+  }
+
+  /** Scroll the log (and not the page around it) so that `row` is in its middle. */
+  _centre(row) {
+    const at = row.getBoundingClientRect();
+    const box = this.host.getBoundingClientRect();
+    this.host.scrollTop += at.top - box.top - box.height / 2 + at.height / 2;
   }
 
   _count() {

@@ -33,7 +33,7 @@ const TIMELINE_REFRESH_MS = 1000; // a live machine's timeline is asked again th
 let timelineRange = { since_t: null, until_t: null }; // the range the timeline shows (null: the whole run)
 
 const playhead = new Playhead(api, {
-  changed: () => queueRender(),
+  changed: () => queueRender(playhead.playing),
   failed: (err) => notice("Could not show that instant: " + (err.detail || err.message), "warn"),
 });
 
@@ -143,7 +143,7 @@ function onEvents(events) {
     if (ev.kind === "structure") structureChanged();
   }
   log.add(events);
-  queueRender();
+  queueRender(true);
 }
 
 function structureChanged() {
@@ -235,10 +235,31 @@ function updateBadge() {
   updateTopBar();
 }
 
-function queueRender() {
-  if (renderQueued) return;
+// Events, and a replay playing, are drawn at most 30 times a second, and at most 4 times a second
+// while the page looks back and only its count of events behind changes: a flood costs the page's
+// computer (often the robot's) a fraction of a core (bench/live_rewind.py). What the user does is
+// drawn at the next frame.
+const PACED_FRAME_MS = 33;
+const BEHIND_FRAME_MS = 250;
+let lastRender = -Infinity;
+let renderTimer = null;
+
+/** Draw at the next animation frame, or, `paced`, not sooner than the pace allows. */
+function queueRender(paced = false) {
+  if (renderQueued && (renderTimer === null || paced)) return;
+  clearTimeout(renderTimer);
+  renderTimer = null;
   renderQueued = true;
-  requestAnimationFrame(render);
+  const pace = playhead.past && !playhead.playing ? BEHIND_FRAME_MS : PACED_FRAME_MS;
+  const wait = paced ? lastRender + pace - performance.now() : 0;
+  if (wait <= 0) {
+    requestAnimationFrame(render);
+    return;
+  }
+  renderTimer = setTimeout(() => {
+    renderTimer = null;
+    requestAnimationFrame(render);
+  }, wait);
 }
 
 /** The status of the instant shown: the playhead's when it looks back, else the stream's present. */
@@ -270,6 +291,7 @@ function updateLink() {
 
 function render() {
   renderQueued = false;
+  lastRender = performance.now();
   if (!store.status) return;
   const s = shownStatus();
   const shown = view(s);

@@ -7,7 +7,11 @@ import { KINDS } from "./schema.js";
 import { Transcript } from "./transcript.js";
 
 const MAX_EVENTS = 5000;
-const MAX_ROWS = 800;
+const MAX_ROWS = 800; // at least; up to MAX_ROWS + BLOCK_ROWS
+// Rows are kept in blocks of this many: adding a row lays out its block only, the oldest rows go a
+// block at a time (dropping rows one by one at the top moved and repainted every row at each frame),
+// and a block out of view is neither laid out nor painted (style.css).
+const BLOCK_ROWS = 100;
 const MAX_ROWS_PER_FRAME = 120; // under a flood only the newest rows of each frame are drawn
 const HIDDEN_AT_FIRST = new Set(["pose"]); // 30 a second: shown only when asked for
 
@@ -79,6 +83,7 @@ export class EventLog {
     this.events = [];
     this.shown = 0; // how many of this.events pass the filters
     this.pending = []; // events not drawn yet
+    this.rowCount = 0; // rows drawn
     this.described = new WeakMap(); // event -> {line, text}: its transcript line and the text the filter searches
     this.needle = ""; // the text filter, lower case
     this.stick = true; // follow the newest row (false once the user scrolls up)
@@ -169,9 +174,12 @@ export class EventLog {
     const fresh = events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS_PER_FRAME).map((ev) => this._row(ev));
     if (fresh.length) {
       this.host.querySelector(".empty")?.remove();
-      this.host.append(...fresh);
-      const extra = this.host.childElementCount - MAX_ROWS;
-      for (let i = 0; i < extra; i++) this.host.firstElementChild.remove();
+      this._append(fresh);
+      for (let first = this.host.firstElementChild; this.rowCount - first.childElementCount >= MAX_ROWS;
+        first = this.host.firstElementChild) {
+        this.rowCount -= first.childElementCount;
+        first.remove();
+      }
     }
     this._count();
     if (stick) this.host.scrollTop = this.host.scrollHeight;
@@ -196,7 +204,6 @@ export class EventLog {
   redraw() {
     this.pending = [];
     this.needle = this.controls.text.value.trim().toLowerCase();
-    this.host.classList.toggle("past", this.past !== null);
     if (this.past) {
       this._drawPast();
       return;
@@ -204,8 +211,7 @@ export class EventLog {
     const matching = this.events.filter((ev) => this._matches(ev));
     this.shown = matching.length;
     const rows = matching.slice(-MAX_ROWS).map((ev) => this._row(ev));
-    this.host.replaceChildren(...(rows.length ? rows : [h("p", { class: "empty", text: "No events." })]));
-    this.selectedRow = null;
+    this._show(rows, "No events.");
     this._count();
     this.stick = true;
     this.host.scrollTop = this.host.scrollHeight;
@@ -225,8 +231,7 @@ export class EventLog {
       rows.push(row);
     }
     at?.classList.add("at");
-    this.host.replaceChildren(...(rows.length ? rows : [h("p", { class: "empty", text: "No events here." })]));
-    this.selectedRow = null;
+    this._show(rows, "No events here.");
     this.controls.count.textContent = `event ${seq}`;
     this.stick = false;
     if (at) {
@@ -238,6 +243,29 @@ export class EventLog {
         if (at.isConnected && this.host.scrollTop === scrolled) this._centre(at);
       });
     }
+  }
+
+  /** Show exactly `rows` (in blocks), or `empty` when there are none. */
+  _show(rows, empty) {
+    this.host.replaceChildren();
+    this.rowCount = 0;
+    this.selectedRow = null;
+    if (rows.length) this._append(rows);
+    else this.host.append(h("p", { class: "empty", text: empty }));
+  }
+
+  /** Add rows after the last, filling the last block before starting another. */
+  _append(rows) {
+    let block = this.host.lastElementChild;
+    for (let i = 0; i < rows.length;) {
+      if (!block?.classList.contains("log-block") || block.childElementCount >= BLOCK_ROWS) {
+        block = this.host.appendChild(h("div", { class: "log-block" }));
+      }
+      const room = BLOCK_ROWS - block.childElementCount;
+      block.append(...rows.slice(i, i + room));
+      i += room;
+    }
+    this.rowCount += rows.length;
   }
 
   /** Scroll the log (and not the page around it) so that `row` is in its middle. */

@@ -14,6 +14,7 @@ if TYPE_CHECKING:
 
 HELP = "run a SMACH-style script and record every machine it executes"
 PASSES_ARGUMENTS_ON = True
+SWITCH_INTERVAL = 0.0005  # s a thread may hold the GIL while another waits for it
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -40,6 +41,10 @@ def main(args: argparse.Namespace) -> int:
 def run_with_dashboard(args: argparse.Namespace, runner: Runner) -> int:
     """Serve every machine the script runs; keep serving afterwards unless --exit, or unless a
     signal (Ctrl-C, SIGTERM) ended the script: one signal stops everything."""
+    # The script's states run in this process's main thread, the server in others: a state that
+    # computes in Python would hold the GIL for 5 ms at a time (the default), and a page then took
+    # 17-25 s to open and its live view ran 1,600 events behind (bench/live_rewind.py).
+    sys.setswitchinterval(SWITCH_INTERVAL)
     srv = start_server(args)
     hub = srv.hub
     runner.on_machine.append(lambda name, container: hub.add_local(container, name=name, can_start=True,

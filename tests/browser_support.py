@@ -24,6 +24,24 @@ ACTIVE_LEAF = """(() => {
     return ids[0] || null;
 })()"""
 
+# A computed style of the first shape of the overlay's copy of a drawing element (static/graph_marks.js:
+# the marks are drawn there), the copy found by its shape lying over the element's; null when none does.
+_MARK_STYLE = """([id, property]) => {
+    const shape = (g) => g.querySelector(':scope > :is(ellipse, polygon, path)');
+    const at = shape(document.getElementById(id)).getBoundingClientRect();
+    const over = (g) => {
+        const b = shape(g)?.getBoundingClientRect();
+        return b && [b.x - at.x, b.y - at.y, b.width - at.width, b.height - at.height].every((d) => Math.abs(d) < 0.75);
+    };
+    const copy = [...document.querySelectorAll('#graph svg.graph-marks g[class]')].find(over);
+    return copy ? getComputedStyle(shape(copy))[property] : null;
+}"""
+
+
+def mark_style(page, element_id: str, css_property: str):
+    """The computed ``css_property`` of the shape the graph draws over ``element_id`` as its mark (None: no mark)."""
+    return page.evaluate(_MARK_STYLE, [element_id, css_property])
+
 
 @contextlib.contextmanager
 def served_page(browser, machine, name: str, **entry):

@@ -7,7 +7,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import watch
+from browser_support import mark_style, watch
 from server.http_server import ServerThread
 from smach_support import failing_machine, run_to_failure
 
@@ -46,25 +46,20 @@ def failed(browser, served):  # noqa: F811
     assert not page.errors
 
 
-def stroke(page, selector):
-    return page.eval_on_selector(selector, "el => getComputedStyle(el).stroke")
-
-
 def test_the_failing_state_is_drawn_failed(failed):
     failed.wait_for_selector('[id="s:/SM_ROOT/SUB/BAD"].failed')
-    assert stroke(failed, '[id="s:/SM_ROOT/SUB/BAD"] > path') == ERROR_RED
+    assert mark_style(failed, "s:/SM_ROOT/SUB/BAD", "stroke") == ERROR_RED
 
 
 def test_an_open_container_that_failed_is_drawn_failed(failed):
     failed.wait_for_selector('[id="c:/SM_ROOT/SUB"].cluster.failed')
-    assert stroke(failed, '[id="c:/SM_ROOT/SUB"] > polygon.frame') == ERROR_RED
+    assert mark_style(failed, "c:/SM_ROOT/SUB", "stroke") == ERROR_RED
 
 
 def test_a_closed_container_that_failed_is_drawn_failed(failed):
     failed.select_option("#depth", "1")  # only the root open: SUB is one node
     failed.wait_for_selector('[id="s:/SM_ROOT/SUB"].failed')
-    shape = failed.eval_on_selector('[id="s:/SM_ROOT/SUB"]', "g => g.querySelector(':scope > polygon, :scope > path').localName")
-    assert stroke(failed, '[id="s:/SM_ROOT/SUB"] > %s' % shape) == ERROR_RED
+    assert mark_style(failed, "s:/SM_ROOT/SUB", "stroke") == ERROR_RED
 
 
 def test_the_picker_says_failed_for_the_machine_shown(failed):

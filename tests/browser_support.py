@@ -9,9 +9,11 @@ import os
 import re
 import signal
 import subprocess
+import threading
 import urllib.parse
 from pathlib import Path
 
+import fsm
 from server.testing.browser import open_page
 from server.http_server import ServerThread
 from server.testing.polling import wait_for
@@ -55,6 +57,25 @@ def served_page(browser, machine, name: str, **entry):
         assert not page.errors
     finally:
         srv.stop()
+
+
+@contextlib.contextmanager
+def page_while_waiting(browser, build, name: str):
+    """A page watching the machine ``build(gate)`` makes, served alone, while it runs and waits for ``gate``
+    (a threading.Event, set at the end)."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    gate = threading.Event()
+    sm = build(gate)
+    runner = threading.Thread(target=sm.execute)
+    try:
+        with served_page(browser, sm, name) as page:
+            runner.start()
+            page.wait_for_selector("#run-state.running")
+            yield page
+    finally:
+        gate.set()
+        if runner.is_alive():
+            runner.join(10)
 
 
 def watch(browser, server, machine: str):

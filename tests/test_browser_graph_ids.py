@@ -7,7 +7,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import served_page
+from browser_support import page_while_waiting
 from fsm.observation.schema import edge_id, state_id
 
 PERCENT = "100%"
@@ -26,19 +26,8 @@ def odd_machine(gate: threading.Event):
 @pytest.fixture(scope="module")
 def waiting_in_vt(browser):  # noqa: F811
     """A page watching the machine while it waits in VT<vertical tab>BAD, after 100% went there."""
-    fsm.set_loggers(*(lambda msg: None,) * 4)
-    gate = threading.Event()
-    sm = odd_machine(gate)
-    runner = threading.Thread(target=sm.execute)
-    try:
-        with served_page(browser, sm, "odd") as page:
-            runner.start()
-            page.wait_for_selector("#run-state.running")
-            yield page
-    finally:
-        gate.set()
-        if runner.is_alive():
-            runner.join(10)
+    with page_while_waiting(browser, odd_machine, "odd") as page:
+        yield page
 
 
 def has_class(page, element_id: str, cls: str) -> None:

@@ -8,7 +8,7 @@ import threading
 
 import fsm
 import pytest
-from browser_support import mark_style, served_page
+from browser_support import mark_style, page_while_waiting
 from fsm.observation.schema import container_id, edge_id, state_id
 
 SUB = "/SM_ROOT/SUB"
@@ -41,22 +41,11 @@ def nested_machine(gate: threading.Event):
 @pytest.fixture(scope="module")
 def waiting_in_x(browser):  # noqa: F811
     """A page watching the machine, drawn with SUB open, while X waits."""
-    fsm.set_loggers(*(lambda msg: None,) * 4)
-    gate = threading.Event()
-    sm = nested_machine(gate)
-    runner = threading.Thread(target=sm.execute)
-    try:
-        with served_page(browser, sm, "nested") as page:
-            runner.start()
-            page.wait_for_selector("#run-state.running")
-            page.select_option("#depth", page.eval_on_selector("#depth", "s => [...s.options].pop().value"))
-            page.wait_for_selector('#graph [id="%s"].active' % state_id(WAITING))
-            page.wait_for_function("() => document.querySelectorAll('#graph svg.graph-marks g.m-active').length >= 3")
-            yield page
-    finally:
-        gate.set()
-        if runner.is_alive():
-            runner.join(10)
+    with page_while_waiting(browser, nested_machine, "nested") as page:
+        page.select_option("#depth", page.eval_on_selector("#depth", "s => [...s.options].pop().value"))
+        page.wait_for_selector('#graph [id="%s"].active' % state_id(WAITING))
+        page.wait_for_function("() => document.querySelectorAll('#graph svg.graph-marks g.m-active').length >= 3")
+        yield page
 
 
 def assert_copies_lie_over(page, cls: str) -> None:

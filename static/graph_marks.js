@@ -48,6 +48,23 @@ export class GraphMarks {
     }
     this.layers = new Map(KINDS.map((kind) => [kind, this.svg.appendChild(document.createElementNS(SVG_NS, "g"))]));
     this.copies = new Map(); // drawing element id -> its copy
+    this.places = new Map(); // layer kind -> Map(drawing element -> a <g> placed in its coordinates)
+  }
+
+  /** The overlay's group, in the layer of `kind`, whose coordinates are those of the drawing's
+   * element `frame`; made once and kept, so that marking an element adds no transform (Chromium then
+   * updates only what was repainted, not the whole page's layers). */
+  _place(kind, frame) {
+    if (!this.places.has(kind)) this.places.set(kind, new Map());
+    const groups = this.places.get(kind);
+    let group = groups.get(frame);
+    if (!group) {
+      group = document.createElementNS(SVG_NS, "g");
+      group.setAttribute("transform", placement(frame, this.drawing).toString());
+      this.layers.get(kind).append(group);
+      groups.set(frame, group);
+    }
+    return group;
   }
 
   setViewBox(text) {
@@ -71,9 +88,9 @@ export class GraphMarks {
       if (!copy) {
         const kind = KINDS.find((k) => el.classList.contains(k)) || "node";
         copy = document.createElementNS(SVG_NS, "g");
-        copy.setAttribute("transform", placement(el, this.drawing).toString());
         copy.append(...drawnParts(el, kind));
-        this.layers.get(kind).append(copy);
+        // A copy's parts are drawn in the element's own coordinates: its parent's, unless it moves them.
+        this._place(kind, el.hasAttribute("transform") ? el : el.parentElement).append(copy);
         this.copies.set(id, copy);
       }
       if (copy.getAttribute("class") !== classes) copy.setAttribute("class", classes);

@@ -48,14 +48,13 @@ export class GraphMarks {
     }
     this.layers = new Map(KINDS.map((kind) => [kind, this.svg.appendChild(document.createElementNS(SVG_NS, "g"))]));
     this.copies = new Map(); // drawing element id -> its copy
-    this.places = new Map(); // layer kind -> Map(drawing element -> a <g> placed in its coordinates)
+    this.places = new Map(KINDS.map((kind) => [kind, new Map()])); // kind -> (drawing element -> its <g> here)
   }
 
   /** The overlay's group, in the layer of `kind`, whose coordinates are those of the drawing's
    * element `frame`; made once and kept, so that marking an element adds no transform (Chromium then
    * updates only what was repainted, not the whole page's layers). */
   _place(kind, frame) {
-    if (!this.places.has(kind)) this.places.set(kind, new Map());
     const groups = this.places.get(kind);
     let group = groups.get(frame);
     if (!group) {

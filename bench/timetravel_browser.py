@@ -7,7 +7,8 @@
   window around the instant (for information);
 - repaint: on a machine of 606 states drawn all open (6 containers of 10 containers of 9 states), the
   page's render of a new instant, from the start of its requestAnimationFrame callback to the end of
-  that frame (style, layout and paint included): <= 16 ms, median of 50 instants;
+  that frame (style, layout and paint included; the timeline's canvas is drawn at the frame after):
+  <= 16 ms, median of 50 instants;
 - drag: the timeline's playhead dragged to and fro over a 100,000-event run for 3 s: frames a second
   the page draws (requestAnimationFrame callbacks) >= 30, and the distinct instants it showed.
 
@@ -211,7 +212,8 @@ def repaint_rows(log: str, rng: random.Random) -> list[tuple[str, str, str, str]
     logged = [frame(s["log"]) for s in seeks if s["log"]]
     return [("repaint an instant, 606 states (%d graph elements) drawn: render to painted frame" % drawn,
              "<= 16 ms", "%.1f ms" % framed, verdict(framed <= 16)),
-            ("  of which the render's script (graph, tree, userdata, timeline)", "", "%.1f ms" % scripted, ""),
+            ("  of which the render's script (graph, tree, userdata, the timeline's text; its canvas draws at "
+             "the next frame)", "", "%.1f ms" % scripted, ""),
             ("  then the event log's window around the instant, render to painted frame", "",
              "%.1f ms" % statistics.median(logged), "")]
 

@@ -1,20 +1,26 @@
 """Live rewind (issue 9): does a page looking back slow the live machine down? Target: while one page looks
 back on a live machine at 1,000 events/s, its transition rate drops <= 5 %.
 
-The machine is a two-state loop whose states compute (a Python loop of a fixed length, about 1 ms: no
-sleeping), so it runs at about 1,000 transitions (= events) a second with nothing else running and any
-CPU or GIL taken from it shows as a lower rate. It runs under ``fsmscope run`` (a real server, a real
-recording, the history beyond the ring read from it), in its own process. In rounds, each a window of
-``--seconds``: no page; one Chromium page showing the machine live; one page looking back (a click on
-the timeline's axis into the past, then playing from there at 1x, again every second). The rates are
-counted afterwards in the recording, over each window; medians of the rounds.
+Two machines, each a two-state loop at about 1,000 transitions (= events) a second, measured in turn:
+one whose states *wait* about 1 ms (as a robot's states wait on hardware, a timer or an action server),
+and one whose states *compute* about 1 ms (a Python loop of a fixed length, no sleeping), so that any CPU
+or GIL taken from it shows as a lower rate: the strictest case, not a robot's usual one. Each runs under
+``fsmscope run`` (a real server, a real recording, the history beyond the ring read from it), in its own
+process. In rounds, each a window of ``--seconds``: no page; one Chromium page showing the machine live;
+one page looking back (a click on the timeline's axis into the past, then playing from there at 1x,
+again every second); and, as a control, the same page looking back at another run, served by another
+process (``fsmscope replay --serve``), which nothing links to the machine but the computer's cores. The
+rates are counted afterwards in the recording, over each window; medians of the rounds.
 
 On this 2-core machine the page's Chromium, the benchmark's driver and the machine's process share the
 cores: the drop includes Chromium's own CPU, the server answering the page (status at an instant,
-history pages, the timeline every second) and streaming it the live events. Run it under the browser
-lock:
+history pages, the timeline every second) and streaming it the live events. The control row says how
+much of it a browser costs a computing process on these cores whatever it shows. ``--own-core`` keeps
+the browser and this driver on the last core (as a page on the operator's own computer would be), so
+what is left is what serving the page costs the machine. Run it under the browser lock:
 
-    flock /tmp/fsmscope-browser.lock .venv/bin/python bench/live_rewind.py [--rounds 3] [--seconds 5]
+    flock /tmp/fsmscope-browser.lock .venv/bin/python bench/live_rewind.py [--rounds 3] [--seconds 5] [--own-core]
+        [--machine waiting|computing]
 """
 
 import argparse
@@ -36,24 +42,31 @@ sys.path.insert(0, ROOT)
 from demo_cpu import TICKS, cpu_seconds  # noqa: E402
 from server.testing.browser import launch_chromium  # noqa: E402
 from table import print_table, verdict  # noqa: E402
+from replay import generate  # noqa: E402  (bench/replay.py: the two-state loop, recorded)
 from timetravel_browser import axis, page_of, served  # noqa: E402
 
 WORK_SECONDS = 0.001  # of computing per state
 WARM_UP = 2.0  # s after the machine starts, and after a page opens
-SCRIPT = '''"""Two states that compute for a fixed number of steps, back and forth, until the file argv[1] exists."""
+OTHER_RUN = 100_000  # events of the control's recorded run
+SCRIPT = '''"""Two states that wait argv[3] s, or compute for argv[3] steps, back and forth, until the file argv[1]
+exists."""
 import os
 import sys
+import time
 
 import fsm
 
-STOP, STEPS = sys.argv[1], int(sys.argv[2])
+STOP, KIND, AMOUNT = sys.argv[1], sys.argv[2], float(sys.argv[3])
 fsm.set_loggers(*[lambda message: None] * 4)  # no line printed per transition
 
 
 def compute(ud):
-    total = 0
-    for i in range(STEPS):
-        total += i
+    if KIND == "waiting":
+        time.sleep(AMOUNT)
+    else:
+        total = 0
+        for i in range(int(AMOUNT)):
+            total += i
     return "stop" if os.path.exists(STOP) else "go"
 
 
@@ -144,29 +157,41 @@ def looking_back(page: Any, rng: random.Random) -> Callable[[float], None]:
     return drive
 
 
-def measure(rounds: int, seconds: float, steps: int, tmp: str) -> list[Window]:
+LOOKING_BACK = "one page looking back"
+CONTROL = "control: a page looking back at another run, another process"
+
+
+def measure(rounds: int, seconds: float, kind: str, amount: float, tmp: str, own_core: bool) -> list[Window]:
     from playwright.sync_api import sync_playwright
 
-    script, log, stop = (os.path.join(tmp, name) for name in ("computing_loop.py", "run.jsonl", "stop"))
+    script, log, stop, other = (os.path.join(tmp, name)
+                                for name in ("loop.py", "run.jsonl", "stop", "other.jsonl"))
     Path(script).write_text(SCRIPT)
+    generate(other, OTHER_RUN)
     rng = random.Random(9)
     windows = []
-    with served(["run", "--exit", "--record", log, script, stop, str(steps)], r"dashboard at (http://\S+)") \
-            as (url, proc), sync_playwright() as pw:
-        browser = launch_chromium(pw)
-        time.sleep(WARM_UP)
-        for _ in range(rounds):
-            windows.append(Window("no page", proc.pid, seconds, idle_until))
-            for condition in ("one page, live", "one page looking back"):
-                opening = time.monotonic()
-                with page_of(browser, url) as page:
-                    opened = time.monotonic() - opening
-                    time.sleep(WARM_UP)
-                    during = looking_back(page, rng) if condition.endswith("back") else idle_until
-                    windows.append(Window(condition, proc.pid, seconds, during))
-                    windows[-1].opened = opened
-                    windows[-1].page_seq = page.evaluate("() => window.fsmscope.liveStatus.last_seq")
-        browser.close()
+    with served(["run", "--exit", "--record", log, script, stop, kind, str(amount)], r"dashboard at (http://\S+)") \
+            as (url, proc), served(["replay", other, "--serve"], r"replaying \S+ at (http://\S+)") as (other_url, _):
+        cores = os.sched_getaffinity(0)
+        if own_core:  # Playwright's driver and Chromium, started after this, inherit it
+            os.sched_setaffinity(0, {max(cores)})
+        with sync_playwright() as pw:
+            browser = launch_chromium(pw)
+            time.sleep(WARM_UP)
+            for _ in range(rounds):
+                windows.append(Window("no page", proc.pid, seconds, idle_until))
+                for condition, address in (("one page, live", url), (LOOKING_BACK, url), (CONTROL, other_url)):
+                    opening = time.monotonic()
+                    with page_of(browser, address) as page:
+                        opened = time.monotonic() - opening
+                        time.sleep(WARM_UP)
+                        during = idle_until if condition == "one page, live" else looking_back(page, rng)
+                        windows.append(Window(condition, proc.pid, seconds, during))
+                        if address == url:
+                            windows[-1].opened = opened
+                            windows[-1].page_seq = page.evaluate("() => window.fsmscope.liveStatus.last_seq")
+            browser.close()
+        os.sched_setaffinity(0, cores)  # the next machine's process must not inherit the browser's core
         Path(stop).touch()
         proc.wait(60)
     with open(log) as recording:
@@ -178,31 +203,44 @@ def measure(rounds: int, seconds: float, steps: int, tmp: str) -> list[Window]:
     return windows
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--rounds", type=int, default=3)
-    parser.add_argument("--seconds", type=float, default=5.0, help="each window")
-    args = parser.parse_args()
-    steps = steps_for(WORK_SECONDS)
-    with tempfile.TemporaryDirectory(prefix="fsmscope-bench-") as tmp:
-        windows = measure(args.rounds, args.seconds, steps, tmp)
-    conditions = list(dict.fromkeys(w.condition for w in windows))
+def rows_of(windows: list[Window]) -> list[tuple[str, str, str, str]]:
+    """One row per condition, in the order measured, its rate against the first's (no page)."""
     rows = []
     base = None
-    for c in conditions:
+    for c in dict.fromkeys(w.condition for w in windows):
         mine = [w for w in windows if w.condition == c]
         rate = statistics.median(w.rate for w in mine)
         cpu = {name: statistics.median(w.cpu[name] for w in mine) * 100 for name in mine[0].cpu}
         base = base or rate
-        targeted = c == "one page looking back"
+        targeted = c == LOOKING_BACK
         page = "" if mine[0].opened is None else " (page opened in %.1f s, its live view %d events behind)" % (
             statistics.median(w.opened for w in mine), statistics.median(w.behind for w in mine))
         rows.append(("%s%s: CPU %% of a core: machine %.0f, server %.0f, browser %.0f; all %d cores %.0f"
                      % (c, page, cpu["machine"], cpu["server"], cpu["browser"], os.cpu_count(), cpu["all"]),
                      "<= 5 % lower" if targeted else "", "%.0f/s (%+.1f %%)" % (rate, (rate / base - 1) * 100),
                      verdict(rate >= 0.95 * base) if targeted else ""))
-    print_table("fsmscope live rewind: transitions/s of a machine computing ~%g ms a state, %d rounds of %g s"
-                % (WORK_SECONDS * 1000, args.rounds, args.seconds), rows)
+    return rows
+
+
+MACHINES = ("waiting", "computing")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--seconds", type=float, default=5.0, help="each window")
+    parser.add_argument("--own-core", action="store_true",
+                        help="keep the browser and this driver on the last core, off the machine's")
+    parser.add_argument("--machine", choices=MACHINES, action="append",
+                        help="measure this machine only (again for another); default: both")
+    args = parser.parse_args()
+    for kind in args.machine or MACHINES:
+        amount = WORK_SECONDS if kind == "waiting" else steps_for(WORK_SECONDS)
+        with tempfile.TemporaryDirectory(prefix="fsmscope-bench-") as tmp:
+            windows = measure(args.rounds, args.seconds, kind, amount, tmp, args.own_core)
+        print_table("fsmscope live rewind: transitions/s of a machine %s ~%g ms a state, %d rounds of %g s%s"
+                    % (kind, WORK_SECONDS * 1000, args.rounds, args.seconds,
+                       ", the browser on a core of its own" if args.own_core else ""), rows_of(windows))
 
 
 if __name__ == "__main__":

@@ -15,7 +15,9 @@ a client whose sender is blocked (a stalled browser) costs nothing per event. A 
 ``CLIENT_QUEUE`` events behind, or behind what the ring keeps, is sent one ``missed`` marker and
 a fresh snapshot instead (coalesced state; the snapshot frame is built once per state and shared).
 A sender blocked for ``SEND_TIMEOUT`` seconds gets the client evicted: its sender is cancelled
-and its socket aborted (a clean close would wait for the unsent data of a stalled peer).
+and its socket aborted (a clean close would wait for the unsent data of a stalled peer). A client
+may ask for a pace (``Client.repace``): at most one frame per that many seconds, each with every
+event since the last (a page looking back needs only its count of events behind).
 
 This module is one piece (about 350 lines) because the feed, its clients' cursors and
 the sender loop share one invariant: what the ring holds, and which client still needs what.
@@ -25,6 +27,7 @@ from __future__ import annotations
 
 import asyncio
 import collections
+import contextlib
 import threading
 import time
 from typing import Any, Callable
@@ -37,11 +40,13 @@ from .timeline import TimelineIndex
 
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
-MAX_BATCH = 1000           # events per frame at most
+MAX_BATCH = 1000           # events per frame at most (a paced client: up to CLIENT_QUEUE)
+MAX_PACE = 10.0            # s: the slowest pace a client may ask for
 HISTORY = 5000             # events of the current run a new client is sent for its log, at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
 HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
 KEYFRAME_EVERY = 1000      # a copy of the Status every this many events, for the status at a seq the ring holds
+DRAIN_INTERVAL = 0.02      # s after a drain during which machine threads hand over without waking the loop
 
 _FRAME_HEAD = b'{"type":"events","events":['
 _FRAME_TAIL = b"]}"
@@ -205,7 +210,8 @@ class Client:
     clients, and nothing at all per client that is not idle (a stalled one is blocked in its send).
     """
 
-    __slots__ = ("feed", "cursor", "need_snapshot", "wake", "send_started", "task", "abort", "evicted")
+    __slots__ = ("feed", "cursor", "need_snapshot", "wake", "send_started", "task", "abort", "evicted",
+                 "pace", "repaced", "sent_at")
 
     def __init__(self, feed: Feed, abort: Callable[[], None] | None) -> None:
         self.feed = feed
@@ -216,6 +222,23 @@ class Client:
         self.task: asyncio.Task | None = None
         self.abort = abort
         self.evicted = False
+        self.pace = 0.0  # s between frames at least (0: each as soon as it can go)
+        self.repaced = asyncio.Event()  # set when the pace changes, to end a wait for the old one
+        self.sent_at = -MAX_PACE  # monotonic time of the last frame sent
+
+    def repace(self, seconds: float) -> None:
+        """Send at most one frame per ``seconds`` (0 to ``MAX_PACE``) from now on; 0: as events come."""
+        self.pace = seconds
+        self.repaced.set()
+
+    async def paced(self) -> None:
+        """Wait until the pace lets the next frame go (at once when it changes meanwhile)."""
+        wait = self.sent_at + self.pace - time.monotonic()
+        if wait <= 0:
+            return
+        self.repaced.clear()
+        with contextlib.suppress(asyncio.TimeoutError):
+            await asyncio.wait_for(self.repaced.wait(), wait)
 
     def take_frames(self) -> list[str]:
         """What to send next (called on the loop): events from the ring, or missed + a snapshot."""
@@ -226,7 +249,7 @@ class Client:
                 return []
             batch = None
             if last - self.cursor < CLIENT_QUEUE:
-                batch = feed.encoded_from(self.cursor, MAX_BATCH)
+                batch = feed.encoded_from(self.cursor, CLIENT_QUEUE if self.pace else MAX_BATCH)
             if batch:
                 self.cursor += len(batch)
                 if len(batch) == 1:
@@ -302,10 +325,19 @@ class Fanout:
             self._scheduled = False
 
     def _drain(self) -> None:
-        self._scheduled = False
+        """Take every hand-off, then keep machine threads from waking the loop for ``DRAIN_INTERVAL``: under
+        a flood the loop (and each client's sender) then runs 50 times a second rather than once per event,
+        each time taking the GIL from the machine's thread (bench/live_rewind.py)."""
         ready = self._ready
         while ready:
             ready.popleft().take_handoff()
+        self.loop.call_later(DRAIN_INTERVAL, self._reopen)
+
+    def _reopen(self) -> None:
+        self._scheduled = False  # before looking: a hand-off that comes after this wakes the loop itself
+        if self._ready:
+            self._scheduled = True
+            self._drain()
 
     def flush(self) -> None:
         """On the loop: take whatever machine threads handed over into the rings (before reading them)."""
@@ -345,9 +377,10 @@ class Fanout:
             client.task.cancel()
 
     async def run_client(self, client: Client, send: Callable[[str], Any]) -> None:
-        """The sender: one frame per event when idle, batches when events come faster."""
+        """The sender: one frame per event when idle, batches when events come faster (or the client's pace)."""
         try:
             while not client.evicted:
+                await client.paced()
                 frames = client.take_frames()
                 if not frames:
                     client.wake.clear()
@@ -355,7 +388,7 @@ class Fanout:
                     await client.wake.wait()
                     continue
                 for frame in frames:
-                    client.send_started = time.monotonic()
+                    client.send_started = client.sent_at = time.monotonic()
                     await send(frame)
                     client.send_started = None
         finally:

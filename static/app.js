@@ -236,9 +236,10 @@ function updateBadge() {
 }
 
 // Events, and a replay playing, are drawn at most 30 times a second, and at most 4 times a second
-// while the page looks back and only its count of events behind changes: a flood costs the page's
-// computer (often the robot's) a fraction of a core (bench/live_rewind.py). What the user does is
-// drawn at the next frame.
+// while the page looks back and only its count of events behind changes; the server is then asked
+// for the live events at that pace too (a frame every 250 ms rather than 50 a second): a flood
+// costs the page's computer (often the robot's) a fraction of a core (bench/live_rewind.py). What
+// the user does is drawn at the next frame.
 const PACED_FRAME_MS = 33;
 const BEHIND_FRAME_MS = 250;
 let lastRender = -Infinity;
@@ -277,6 +278,7 @@ function showInstant() {
     liveMachine: !playhead.replay,
   });
   document.body.classList.toggle("looking-back", past && !playhead.replay);
+  stream?.pace(past ? BEHIND_FRAME_MS : 0);
 }
 
 let linkTimer = null;

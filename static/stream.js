@@ -31,6 +31,18 @@ export class Stream {
     this.latencyMs = null;
     this.arrivals = []; // [ms timestamp, count]
     this.connects = 0;
+    this.paceMs = 0;
+  }
+
+  /** Ask for at most one frame every `ms` (0: each as it comes), now and after any reconnect. */
+  pace(ms) {
+    if (ms === this.paceMs) return;
+    this.paceMs = ms;
+    this._sendPace();
+  }
+
+  _sendPace() {
+    if (this.ws?.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify({ type: "pace", ms: this.paceMs }));
   }
 
   start() {
@@ -71,6 +83,7 @@ export class Stream {
     ws.onopen = () => {
       this.failures = 0;
       this.connects += 1;
+      if (this.paceMs) this._sendPace();
       this._setState("live");
     };
     ws.onmessage = (msg) => this._onFrame(msg.data);

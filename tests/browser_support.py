@@ -48,11 +48,12 @@ def mark_style(page, element_id: str, css_property: str):
 @contextlib.contextmanager
 def served_page(browser, machine, name: str, **entry):
     """A page watching ``machine``, served alone by a fresh server (``entry``: add_local's options);
-    the page must end without a script error."""
+    the page must end without a script error. ``page.server`` is the server."""
     srv = ServerThread().start()
     srv.hub.add_local(machine, name=name, **entry)
     try:
         page = watch(browser, srv, name)
+        page.server = srv
         yield page
         assert not page.errors
     finally:

@@ -304,3 +304,21 @@ def test_back_to_live_shows_the_machine_as_it_is_now(live_page):
     wait_for(lambda: not live_page.evaluate("window.fsmscope.instant.past"), timeout=5, what="live again")
     assert live_page.evaluate("window.fsmscope.status === window.fsmscope.liveStatus")
     live_page.wait_for_selector("button.tl-live", state="hidden")
+
+
+def paces(page) -> list:
+    """The pace (s) each of the server's stream clients of the live machine asked for."""
+    return sorted(client.pace for client in page.server.hub.get("ticker").clients)
+
+
+def test_a_page_looking_back_asks_for_the_live_events_four_times_a_second_only(live_page):
+    assert paces(live_page) == [0.0]
+    look_back(live_page)
+    wait_for(lambda: paces(live_page) == [0.25], timeout=5, what="the page to ask for a pace")
+
+
+def test_back_to_live_asks_for_every_event_as_it_comes_again(live_page):
+    look_back(live_page)
+    wait_for(lambda: paces(live_page) == [0.25], timeout=5, what="the page to ask for a pace")
+    live_page.click("button.tl-live")
+    wait_for(lambda: paces(live_page) == [0.0], timeout=5, what="the page to ask for every event")

@@ -1,11 +1,12 @@
 """The websocket stream and ingest against a real uvicorn, with the `websockets` client."""
 
+import json
 import threading
 import time
 
 import fsm
 import pytest
-from websockets.exceptions import InvalidStatus
+from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
 from server import fanout
@@ -173,3 +174,94 @@ def test_publisher_keeps_the_machine_running_without_a_server_and_reconnects():
         wait.release.set()
         pub.close(1)
         srv2.stop()
+
+
+def loop_in_background(sm):
+    """Run ``sm`` in a thread; returns the thread."""
+    runner = threading.Thread(target=sm.execute, daemon=True)
+    runner.start()
+    return runner
+
+
+def ticking_loop(n, delay, halt=None):
+    """A one-state loop that runs ``n`` times, sleeping ``delay`` s each time, or until ``halt`` is set.
+
+    (A preempt would not end it: SMACH preempts the next state, and a CBState never looks.)"""
+    count = {"n": 0}
+
+    def tick(ud):
+        time.sleep(delay)
+        count["n"] += 1
+        return "stop" if count["n"] >= n or (halt and halt.is_set()) else "again"
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["again", "stop"]), {"again": "A", "stop": "done"})
+    return sm
+
+
+def test_a_paced_client_gets_every_event_in_at_most_one_frame_per_pace(live_server):
+    sm = ticking_loop(1000, 0.001)  # about 2,000 events in 1.5 s
+    entry = live_server.hub.add_local(sm, name="loop")
+    with stream(live_server, "loop") as ws:
+        frames(ws, lambda got: len(got) == 1)
+        ws.send(json.dumps({"type": "pace", "ms": 400}))
+        wait_for(lambda: [c.pace for c in entry.clients] == [0.4])
+        started = time.monotonic()
+        loop_in_background(sm)
+        got = frames(ws, lambda got: any(e["kind"] == "terminate" and e["path"] == "/SM_ROOT"
+                                         for e in events_of(got)), timeout=30)
+        elapsed = time.monotonic() - started
+    seqs = [e["seq"] for e in events_of(got)]
+    assert seqs == list(range(seqs[0], seqs[0] + len(seqs)))  # nothing lost, nothing twice
+    assert len(got) <= elapsed / 0.4 + 2
+
+
+def test_a_pace_of_zero_ends_a_wait_for_the_old_pace_at_once(live_server):
+    halt = threading.Event()
+    sm = ticking_loop(100000, 0.001, halt)
+    entry = live_server.hub.add_local(sm, name="loop")
+    runner = None
+    try:
+        with stream(live_server, "loop") as ws:
+            frames(ws, lambda got: len(got) == 1)
+            ws.send(json.dumps({"type": "pace", "ms": 10000}))
+            wait_for(lambda: [c.pace for c in entry.clients] == [10.0])
+            runner = loop_in_background(sm)
+            with pytest.raises(TimeoutError):  # the snapshot went just now: the next frame waits 10 s
+                ws.recv(timeout=0.5)
+            ws.send(json.dumps({"type": "pace", "ms": 0}))
+            asked = time.monotonic()
+            [frame] = frames(ws, lambda got: len(got) == 1, timeout=5)
+            assert time.monotonic() - asked < 2
+            assert frame["type"] == "events"
+    finally:
+        halt.set()  # the machine's log lines must not reach the tests after this one
+        if runner:
+            runner.join(5)
+
+
+@pytest.mark.parametrize("message", ["not json", '{"type": "hold"}', '{"type": "pace", "ms": -1}',
+                                     '{"type": "pace", "ms": 1.5}', '{"type": "pace", "ms": 99999}', "[]"])
+def test_a_message_other_than_a_pace_closes_the_stream_saying_why(live_server, message):
+    live_server.hub.add_local(two_state_machine(), name="two")
+    with stream(live_server, "two") as ws:
+        frames(ws, lambda got: len(got) == 1)
+        ws.send(message)
+        with pytest.raises(ConnectionClosed) as info:
+            while True:
+                ws.recv(timeout=5)
+    assert info.value.rcvd.code == 1007
+    assert "pace" in info.value.rcvd.reason or "JSON" in info.value.rcvd.reason
+
+
+def test_a_flood_wakes_the_event_loop_at_most_once_per_drain_interval(live_server, monkeypatch):
+    drains = []
+    original = fanout.Fanout._drain
+    monkeypatch.setattr(fanout.Fanout, "_drain", lambda self: (drains.append(time.monotonic()), original(self)))
+    sm = blob_loop(5000, size=10)
+    live_server.hub.add_local(sm, name="loop")
+    started = time.monotonic()
+    sm.execute()
+    elapsed = time.monotonic() - started
+    assert len(drains) <= elapsed / fanout.DRAIN_INTERVAL + 3

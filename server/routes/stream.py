@@ -2,7 +2,7 @@
 
 A transition reaches the browser in three hops: the machine's ``fanout.Observer`` (machine
 thread), ``Feed.take_handoff`` (event loop), and this route's sender, ``Fanout.run_client``,
-which writes each frame with the server's own ``send``. ``KeepServerSend`` (installed by the
+which writes each frame with the server's own ``send`` (at the pace the client asks for, if any). ``KeepServerSend`` (installed by the
 app outside Starlette's wrappers) keeps that ``send`` in the scope: frames skip the per-message
 wrappers, and a stalled socket can be aborted through the protocol the ``send`` is bound to.
 """
@@ -11,11 +11,13 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import json
 from typing import Any, Callable
 
 from fastapi import APIRouter, WebSocket
 
 from ..auth import websocket_subprotocol
+from ..fanout import MAX_PACE, Client
 from .deps import HubDep, deny_websocket, refused
 
 router = APIRouter()
@@ -70,7 +72,7 @@ async def stream(websocket: WebSocket, name: str, hub: HubDep) -> None:
     client = fanout.subscribe(entry, since, _abort(server_send))
     sender = asyncio.ensure_future(fanout.run_client(client, send))
     client.task = sender
-    receiver = asyncio.ensure_future(_drain_incoming(websocket))
+    receiver = asyncio.ensure_future(_receive(websocket, client))
     try:
         await asyncio.wait([sender, receiver], return_when=asyncio.FIRST_COMPLETED)
     finally:
@@ -82,9 +84,29 @@ async def stream(websocket: WebSocket, name: str, hub: HubDep) -> None:
                 await task
 
 
-async def _drain_incoming(websocket: WebSocket) -> None:
-    """Client-to-server messages are ignored; returns when the client leaves."""
+async def _receive(websocket: WebSocket, client: Client) -> None:
+    """The client's messages: ``{"type": "pace", "ms": N}``; anything else closes the stream with code
+    1007 and says why. Returns when the client leaves."""
     while True:
         message = await websocket.receive()
         if message["type"] == "websocket.disconnect":
             return
+        try:
+            client.repace(pace_of(message.get("text")))
+        except ValueError as exc:
+            await websocket.close(1007, str(exc)[:120])
+            return
+
+
+def pace_of(text: str | None) -> float:
+    """The seconds a pace message asks for; ValueError saying what is wrong with any other message."""
+    try:
+        message = json.loads(text) if text is not None else None
+    except ValueError:
+        raise ValueError("a message must be JSON text") from None
+    if not isinstance(message, dict) or message.get("type") != "pace":
+        raise ValueError('the only message is {"type": "pace", "ms": N}')
+    ms = message.get("ms")
+    if isinstance(ms, bool) or not isinstance(ms, int) or not 0 <= ms <= MAX_PACE * 1000:
+        raise ValueError("pace ms must be an integer from 0 to %d" % (MAX_PACE * 1000))
+    return ms / 1000

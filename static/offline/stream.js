@@ -7,7 +7,8 @@ import { recorded } from "./recording.js";
 const HISTORY = 5000; // events of the run sent for the log, as server/fanout.py's HISTORY
 
 export class Stream {
-  /** The handlers and options of static/stream.js's Stream (only snapshot and state are called). */
+  /** The handlers and options of static/stream.js's Stream (only snapshot and state are called; pace is
+   * taken and has nothing to do). */
   constructor(name, handlers) {
     this.name = name;
     this.handlers = handlers;
@@ -31,6 +32,9 @@ export class Stream {
   rate() {
     return 0;
   }
+
+  /** Nothing comes after the snapshot, so there is nothing to pace. */
+  pace() {}
 
   _setState(state) {
     this.state = state;

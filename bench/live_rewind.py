@@ -15,7 +15,8 @@ rates are counted afterwards in the recording, over each window; medians of the 
 On this 2-core machine the page's Chromium, the benchmark's driver and the machine's process share the
 cores: the drop includes Chromium's own CPU, the server answering the page (status at an instant,
 history pages, the timeline every second) and streaming it the live events. The control row says how
-much of it a browser costs a computing process on these cores whatever it shows. ``--own-core`` keeps
+much of it a browser costs the machine on these cores whatever it shows, and the last row compares
+looking back with it: what looking back itself costs. ``--own-core`` keeps
 the browser and this driver on the last core (as a page on the operator's own computer would be), so
 what is left is what serving the page costs the machine. Run it under the browser lock:
 
@@ -219,6 +220,9 @@ def rows_of(windows: list[Window]) -> list[tuple[str, str, str, str]]:
                      % (c, page, cpu["machine"], cpu["server"], cpu["browser"], os.cpu_count(), cpu["all"]),
                      "<= 5 % lower" if targeted else "", "%.0f/s (%+.1f %%)" % (rate, (rate / base - 1) * 100),
                      verdict(rate >= 0.95 * base) if targeted else ""))
+    back, control = (statistics.median(w.rate for w in windows if w.condition == c) for c in (LOOKING_BACK, CONTROL))
+    rows.append(("looking back against the control: what looking back costs beyond a browser on these cores",
+                 "<= 5 % lower", "%+.1f %%" % ((back / control - 1) * 100), verdict(back >= 0.95 * control)))
     return rows
 
 

@@ -31,7 +31,7 @@ from .ros.simple_action_state import SimpleActionState
 from .ros.monitor_state import MonitorState
 from .ros.condition_state import ConditionState
 from .logfiles.recorder import Recorder
-from . import core, logfiles, observation, ros
+from . import core, debugging, logfiles, observation, ros
 
 # The flat module paths of before the grouping (``from fsm.bus import get_bus``, ``fsm.log``) keep working.
 for _package in (core, ros, observation, logfiles):

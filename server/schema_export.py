@@ -85,7 +85,8 @@ def tables() -> dict[str, str]:
     out.update(envelope=_table(schema.ENVELOPE), node=_table(schema.NODE_FIELDS),
                container=_table(schema.CONTAINER_FIELDS), transition=_table(schema.TRANSITION_FIELDS),
                status=_table(schema.STATUS_FIELDS), container_status=_table(schema.CONTAINER_STATUS_FIELDS),
-               preempt=_table(schema.PREEMPT_FIELDS))
+               preempt=_table(schema.PREEMPT_FIELDS), debug_status=_table(schema.DEBUG_STATUS_FIELDS),
+               hold=_table(schema.HOLD_FIELDS), breakpoint=_table(schema.BREAKPOINT_FIELDS))
     return out
 
 

@@ -5,7 +5,7 @@
 export const SCHEMA_VERSION = 1;
 
 /** Every event kind. */
-export const KINDS = Object.freeze(["structure", "start", "transition", "terminate", "userdata", "preempt", "error", "log", "feedback", "control", "pose", "snapshot"]);
+export const KINDS = Object.freeze(["structure", "start", "transition", "terminate", "userdata", "preempt", "error", "log", "feedback", "control", "debug", "pose", "snapshot"]);
 
 /** Where a served machine's events come from, and which of those a dashboard may control. */
 export const SOURCES = Object.freeze({"local": "local", "ingest": "ingest", "replay": "replay"});

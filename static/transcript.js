@@ -113,6 +113,7 @@ export class Transcript {
       return { level: ev.level || "info", text: String(ev.msg ?? "") };
     }
     if (ev.kind === "control") return controlLine(ev);
+    if (ev.kind === "debug") return debugLine(ev);
     if (!["start", "transition", "terminate"].includes(ev.kind)) return null;
     const type = containerType(ev, this.nodeOf(ev.path, ev.machine));
     if (type === "Iterator") return null; // SMACH's Iterator prints only "Iterating ..." (a log event)
@@ -148,6 +149,39 @@ function controlLine(ev) {
     level: ev.result === "accepted" ? "info" : "warn",
     text: `Control ${ev.action ?? "?"}${params} from ${ev.client ?? "?"}${reason}: ${result}`,
   };
+}
+
+const MODE_WORDS = { run: "running", pause: "pausing at the next transition", step: "stepping one transition" };
+
+/** A debug event's line, in the words of fsm/logfiles/transcript.py's debug_message. */
+function debugLine(ev) {
+  const by = ev.by ? ` by ${ev.by}` : "";
+  switch (ev.action) {
+    case "mode": {
+      const level = ev.level ? ` (the step ends at ${ev.level}'s next transition)` : "";
+      return { level: "info", text: `Debugger ${MODE_WORDS[ev.mode] ?? ev.mode}${level}${by}` };
+    }
+    case "hold": {
+      const outcome = ev.outcome !== null && ev.outcome !== undefined ? `:'${ev.outcome}'` : "";
+      return { level: "warn", text: `Holding ${ev.at} '${ev.state}'${outcome}: ${ev.detail}` };
+    }
+    case "release":
+      return { level: "info", text: `Released '${ev.state}' (${ev.by ?? "?"})` };
+    case "forced": {
+      const said = ev.returned === null || ev.returned === undefined ? "it did not run" : `it returned '${ev.returned}'`;
+      return { level: "warn", text: `Forced outcome '${ev.outcome}' of '${ev.state}' (${said})${by}` };
+    }
+  }
+  const listed = (ev.breakpoints ?? []).map(breakpointText).join("; ") || "none";
+  return { level: "info", text: `Breakpoints: ${listed}${by}` };
+}
+
+/** `before /SM_ROOT/PICK/CLOSE when attempts > 2`, as fsm/logfiles/transcript.py's breakpoint_text. */
+export function breakpointText(bp) {
+  let text = `${bp.at} ${bp.state}`;
+  if (bp.outcome !== null && bp.outcome !== undefined) text += ` with outcome '${bp.outcome}'`;
+  if (bp.when) text += ` when ${bp.when}`;
+  return text;
 }
 
 /** An event that stands for no SMACH line, described for the event log. */

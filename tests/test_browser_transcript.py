@@ -4,18 +4,21 @@ Both rebuild SMACH's log lines from the same events; the Python side is checked 
 runtime's own printed lines (tests/test_transcript.py). Here each example is recorded as
 ``fsmscope run --record`` records it, plus machines for what no example does (an Iterator, a
 Concurrence that services a preempt, with and without a 'preempted' outcome, two outcomes of the
-last state leading to one container outcome), and the events of each run are fed to both, in
+last state leading to one container outcome, a debugged run), and the events of each run are fed to both, in
 Chromium for the JavaScript.
 """
 
 from __future__ import annotations
 
 import threading
+import time
 from pathlib import Path
 
 import fsm
 import pytest
+from fsm.debugging import Debugger
 from fsm.logfiles.log_reader import read_events
+from fsm.observation import introspection
 from fsm.logfiles.transcript import Transcript
 
 from recording_support import EXAMPLES, FAST, cli, record
@@ -55,6 +58,47 @@ def two_outcomes_to_one_run(path: Path) -> None:
     record(machine(["done"], [("A", Out("b", outcomes=["a", "b"]), {"a": "done", "b": "done"})]), path)
 
 
+def debugged_run(path: Path) -> None:
+    """SM_ROOT: WAIT -> A <-> B, A 'stop' -> LAST: a conditional breakpoint after B holds, a step
+    holds after A, A's outcome is forced to 'stop', the debugger resumes (every kind of debug event)."""
+    ready, finish = threading.Event(), threading.Event()
+    count = {"n": 0}
+
+    def tick(ud):
+        count["n"] += 1
+        ud.n = count["n"]
+        return "go"
+
+    def held():
+        while not debugger.holds():
+            time.sleep(0.005)
+
+    def drive():
+        while introspection.reporter_of(sm) is None:
+            time.sleep(0.005)
+        debugger.set_breakpoints([{"state": "/SM_ROOT/B", "at": "after", "when": "n >= 2"}], by="tester")
+        ready.set()
+        held()
+        debugger.set_breakpoints([])
+        debugger.step(by="tester")
+        held()
+        debugger.force("/SM_ROOT/A", "stop", by="tester")
+        debugger.resume(by="tester")
+        finish.set()
+
+    ticking = {"outcomes": ["go", "stop"], "output_keys": ["n"]}
+    sm = machine(["done"], [("WAIT", fsm.CBState(lambda ud: ready.wait(5) and "go", outcomes=["go"]), {"go": "A"}),
+                            ("A", fsm.CBState(tick, **ticking), {"go": "B", "stop": "LAST"}),
+                            ("B", fsm.CBState(tick, **ticking), {"go": "A", "stop": "done"}),
+                            ("LAST", fsm.CBState(lambda ud: finish.wait(5) and "go", outcomes=["go"]), {"go": "done"})])
+    debugger = Debugger(sm)
+    driver = threading.Thread(target=drive)
+    driver.start()
+    record(sm, path)
+    driver.join(5)
+    debugger.detach()
+
+
 def example_run(name: str):
     def run(path: Path) -> None:
         done = cli("run", Path(EXAMPLES) / (name + ".py"), "--record", path, env=FAST)
@@ -65,7 +109,8 @@ def example_run(name: str):
 RUNS = {**{p.stem: example_run(p.stem) for p in sorted(Path(EXAMPLES).glob("*.py"))},
         "iterator": iterator_run, "two_outcomes_to_one": two_outcomes_to_one_run,
         "concurrence_serviced_preempt": serviced_preempt_run(["preempted", "done"]),
-        "concurrence_serviced_preempt_without_preempted_outcome": serviced_preempt_run(["done"])}
+        "concurrence_serviced_preempt_without_preempted_outcome": serviced_preempt_run(["done"]),
+        "debugged": debugged_run}
 
 
 @pytest.fixture(scope="module")

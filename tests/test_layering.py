@@ -1,7 +1,7 @@
 """The layering, kept by reading every import (ast), including those inside functions.
 
 fsm is the runtime: the standard library only (orjson when installed) and nothing of the web or
-the simulator. Inside fsm the core never imports its extensions (ros, logfiles). sim never imports
+the simulator. Inside fsm the core never imports its extensions (ros, logfiles, debugging). sim never imports
 server; server imports sim only in its composition root, the CLI (server/cli/).
 """
 
@@ -22,6 +22,7 @@ FSM_ARROWS = {
     "observation": {"observation", "core"},
     "ros": {"ros", "core", "observation"},
     "logfiles": {"logfiles", "observation", "core"},
+    "debugging": {"debugging", "observation", "core"},
 }
 
 COMPOSITION_ROOT = ROOT / "server" / "cli"

@@ -165,13 +165,18 @@ class Concurrence(Container):
         try:
             if self._transition_cbs:
                 self.call_transition_cbs()
-            try:
-                outcome = state.execute(Remapper(self.userdata, state.get_registered_input_keys(),
-                                                 state.get_registered_output_keys(), self._remappings[label]))
-            except BaseException as exc:
-                InvalidStateError(("Could not execute child state '%s': " % label) + traceback.format_exc())
-                self._fail(label, exc)
-                return
+            dbg = self._debugger
+            outcome = dbg.before(self, label, state) if dbg is not None else None
+            if outcome is None:
+                try:
+                    outcome = state.execute(Remapper(self.userdata, state.get_registered_input_keys(),
+                                                     state.get_registered_output_keys(), self._remappings[label]))
+                except BaseException as exc:
+                    self._fail(label, exc)
+                    return
+            dbg = self._debugger
+            if outcome is not None and dbg is not None:
+                outcome = dbg.after(self, label, state, outcome)
             if outcome is None:
                 error = InvalidStateError("Concurrent state '%s' returned no outcome on termination." % label)
                 error._fsm_own = True

@@ -80,14 +80,13 @@ class Iterator(Container):
                 break
             log.loginfo("Iterating %s of %s" % (str(item), str(items)))
             self.userdata[self._items_label] = item
-            try:
-                state_outcome = self._state.execute(self.userdata)
-            except InvalidUserCodeError:
-                raise
-            except Exception as exc:
-                raise introspection.carry_reported(InvalidUserCodeError(
-                    "Could not execute iterator state '%s' of type '%s': " % (self._state_label, self._state)
-                    + traceback.format_exc()), exc) from exc
+            dbg = self._debugger
+            state_outcome = dbg.before(self, self._state_label, self._state) if dbg is not None else None
+            if state_outcome is None:
+                state_outcome = self._run_state()
+            dbg = self._debugger
+            if dbg is not None:
+                state_outcome = dbg.after(self, self._state_label, self._state, state_outcome)
             if rep is not None:
                 self._report_changes()
             if self._preempt_requested:
@@ -110,6 +109,16 @@ class Iterator(Container):
                                    "outcome": None if outcome is None else str(outcome), "active": []})
         self.call_termination_cbs(self._state_label, outcome)
         return outcome
+
+    def _run_state(self) -> Any:
+        try:
+            return self._state.execute(self.userdata)
+        except InvalidUserCodeError:
+            raise
+        except Exception as exc:
+            raise introspection.carry_reported(InvalidUserCodeError(
+                "Could not execute iterator state '%s' of type '%s': " % (self._state_label, self._state)
+                + traceback.format_exc()), exc) from exc
 
     def request_preempt(self) -> None:
         State.request_preempt(self)

@@ -9,11 +9,13 @@ class State:
     """Base class of every state and container.
 
     ``_reporter`` and ``_path`` are set by ``fsm.observation.introspection`` when a tool observes the
-    machine this state belongs to; they stay None otherwise, which costs nothing.
+    machine this state belongs to, and a container's ``_debugger`` by ``fsm.debugging`` when one
+    debugs it; they stay None otherwise, which costs nothing.
     """
 
     _reporter = None
     _path: str | None = None
+    _debugger = None
 
     def __init__(self, outcomes: Iterable[str] = [], input_keys: list[str] = [],
                  output_keys: list[str] = [], io_keys: list[str] = []) -> None:

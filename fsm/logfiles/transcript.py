@@ -9,8 +9,9 @@ A line reads ``12:34:56.789 /SM_ROOT/SUB [  INFO ] : State machine transitioning
 everything from the level prefix on is exactly what SMACH would have printed. Once a log
 holds more than one machine, the path is prefixed with the machine's name (``foo_bar:/SM_ROOT``).
 
-SMACH had no operator controls: a ``control`` event (preempt, initial-state, start, publish from
-the dashboard) reads word for word as the browser's transcript (static/transcript.js) writes it.
+SMACH had no operator controls or debugger: a ``control`` event (preempt, initial-state, start,
+publish from the dashboard) and a ``debug`` event (pause, hold, step, forced outcome, breakpoints)
+read word for word as the browser's transcript (static/transcript.js) writes them.
 """
 
 from __future__ import annotations
@@ -67,6 +68,8 @@ class Transcript:
             return [(event.get("level", "info"), str(event.get("msg", "")))]
         if kind == "control":
             return [control_message(event)]
+        if kind == "debug":
+            return [debug_message(event)]
         if kind not in ("start", "transition", "terminate"):
             return []
         ctype = self.structures.container_type(event)
@@ -117,6 +120,39 @@ def control_message(event: dict) -> tuple[str, str]:
     result = "accepted" if accepted else "refused: %s" % event.get("result")
     return ("info" if accepted else "warn", "Control %s%s from %s%s: %s" % (
         _coalesce(event.get("action"), "?"), params, _coalesce(event.get("client"), "?"), reason, result))
+
+
+def debug_message(event: dict) -> tuple[str, str]:
+    """(level, text) of a debug event, as static/transcript.js words it."""
+    action, state = event["action"], event.get("state")
+    by = " by %s" % event["by"] if event.get("by") else ""
+    if action == "mode":
+        level = " (the step ends at %s's next transition)" % event["level"] if event.get("level") else ""
+        return "info", "Debugger %s%s%s" % (MODE_WORDS.get(event["mode"], event["mode"]), level, by)
+    if action == "hold":
+        outcome = ":'%s'" % event["outcome"] if event.get("outcome") is not None else ""
+        return "warn", "Holding %s '%s'%s: %s" % (event["at"], state, outcome, event["detail"])
+    if action == "release":
+        return "info", "Released '%s' (%s)" % (state, _coalesce(event.get("by"), "?"))
+    if action == "forced":
+        returned = event.get("returned")
+        said = "it did not run" if returned is None else "it returned '%s'" % returned
+        return "warn", "Forced outcome '%s' of '%s' (%s)%s" % (event["outcome"], state, said, by)
+    listed = "; ".join(breakpoint_text(bp) for bp in event.get("breakpoints") or []) or "none"
+    return "info", "Breakpoints: %s%s" % (listed, by)
+
+
+MODE_WORDS = {"run": "running", "pause": "pausing at the next transition", "step": "stepping one transition"}
+
+
+def breakpoint_text(bp: dict) -> str:
+    """``before /SM_ROOT/PICK/CLOSE when attempts > 2``, as static/transcript.js writes it."""
+    text = "%s %s" % (bp.get("at"), bp.get("state"))
+    if bp.get("outcome") is not None:
+        text += " with outcome '%s'" % bp["outcome"]
+    if bp.get("when"):
+        text += " when %s" % bp["when"]
+    return text
 
 
 def _coalesce(value: Any, default: Any) -> Any:

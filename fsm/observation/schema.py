@@ -279,6 +279,17 @@ CONTAINER_STATUS_FIELDS = (Field("active", LIST_STR, doc="active children's labe
                                  doc="the keys its last transition wrote: {key: {old (absent: a new key), new}}"),
                            Field("written", BOOL, required=False,
                                  doc="its userdata was written since its last transition"))
+DEBUG_ACTIONS = ("mode", "hold", "release", "forced", "breakpoints")
+BREAKPOINT_FIELDS = (Field("state", PATH, doc="the state's path"), Field("at", _one_of("before", "after")),
+                     Field("outcome", OPT_STR, doc="after: only this outcome"),
+                     Field("when", OPT_STR, doc="a condition over the container's userdata"))
+HOLD_FIELDS = (Field("path", PATH, doc="the holding container's"), Field("state", STR), Field("at", _one_of("before", "after")),
+               Field("outcome", OPT_STR), Field("reason", STR), Field("detail", STR), Field("seq", SEQ, doc="the hold event's"))
+DEBUG_STATUS_FIELDS = (Field("mode", _one_of("run", "pause", "step")), Field("level", _nullable(PATH)),
+                       Field("holds", _list_of(Type("a hold", lambda h: _fields_problem(h, HOLD_FIELDS)),
+                                               "a list of holds"), doc="{path, state, at, outcome, reason, detail, seq}"),
+                       Field("breakpoints", _list_of(Type("a breakpoint", lambda b: _fields_problem(b, BREAKPOINT_FIELDS)),
+                                                     "a list of breakpoints"), doc="{state, at, outcome, when}"))
 POSE_FIELDS = (Field("seq", SEQ, doc="the pose event's"), Field("t", NUMBER),
                Field("joints", MAP_NUMBER), Field("bodies", MAP_BODY_POSE, required=False))
 PREEMPT_FIELDS = (Field("seq", SEQ, doc="the preempt event's"), Field("t", NUMBER, doc="when it was requested"),
@@ -297,6 +308,8 @@ STATUS_FIELDS = (
           required=False, doc="a preempt requested and not over yet (below)"),
     Field("pose", _nullable(Type("a pose", lambda v: _fields_problem(v, POSE_FIELDS))), required=False,
           doc="the robot's last recorded pose: {seq, t, joints, bodies}"),
+    Field("debug", _nullable(Type("a debugger's state", lambda v: _fields_problem(v, DEBUG_STATUS_FIELDS))),
+          required=False, doc="null until a debug event: {mode, level, holds, breakpoints} (below)"),
 )
 STATUS = Type("a machine status (fsm.observation.status.Status.to_dict())",
               lambda v: _fields_problem(v, STATUS_FIELDS))
@@ -347,6 +360,23 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
         Field("reason", OPT_STR, required=False, doc="the operator's words"),
         Field("client", STR, doc="who asked (an address)"), Field("result", STR, doc="'accepted' or why not"),
         Field("params", OBJECT, required=False, doc="what was asked"))),
+    Kind("debug", "The debugger (fsm.debugging) changed mode, held or released a transition, forced an outcome "
+                  "or replaced its breakpoints; path is the container's (the root's for mode and breakpoints).", (
+        Field("action", _one_of(*DEBUG_ACTIONS)),
+        Field("mode", _one_of("run", "pause", "step"), required=False, doc="mode: what it is now"),
+        Field("level", _nullable(PATH), required=False, doc="mode step: the container whose next transition "
+                                                            "ends the step (null: the next anywhere)"),
+        Field("state", STR, required=False, doc="hold, release, forced: the child's label"),
+        Field("at", _one_of("before", "after"), required=False,
+              doc="hold, release: before the child runs, or after it returned (the transition held)"),
+        Field("outcome", OPT_STR, required=False, doc="hold: the outcome to be taken; release, forced: the one taken"),
+        Field("returned", OPT_STR, required=False, doc="forced: what the state returned (null: it did not run)"),
+        Field("reason", _one_of("pause", "step", "breakpoint"), required=False, doc="hold: why"),
+        Field("detail", STR, required=False, doc="hold: in words ('hit breakpoint before PICK/CLOSE when ...')"),
+        Field("by", OPT_STR, required=False, doc="mode, forced, breakpoints: who asked; release: what ended the "
+                                                  "hold (resume, step, force, preempt, shutdown, detach)"),
+        Field("breakpoints", _list_of(Type("a breakpoint", lambda b: _fields_problem(b, BREAKPOINT_FIELDS)),
+                                      "a list of breakpoints"), required=False, doc="breakpoints: the whole set"))),
     Kind("pose", "The robot's pose, sampled at the rate the 3D view draws it (the demo: 30 Hz).", (
         Field("joints", MAP_NUMBER, doc="joint positions by joint name (radians, metres)"),
         Field("bodies", MAP_BODY_POSE, required=False,
@@ -394,14 +424,35 @@ _ENVELOPE = _compile(ENVELOPE)
 _KIND_FIELDS = {name: _compile(k.fields) for name, k in KINDS.items()}
 
 
+def _structure_problem(ev: dict) -> str | None:
+    if ev["root"]["path"] != ev["path"]:
+        return "structure.root.path %r differs from the event's path %r" % (ev["root"]["path"], ev["path"])
+    return None
+
+
+# What each debug action needs besides the fields every debug event may have.
+DEBUG_NEEDS = {"mode": ("mode",), "hold": ("state", "at", "reason", "detail"), "release": ("state", "at"),
+               "forced": ("state", "outcome"), "breakpoints": ("breakpoints",)}
+
+
+def _debug_problem(ev: dict) -> str | None:
+    missing = [name for name in DEBUG_NEEDS[ev["action"]] if name not in ev]
+    return "debug %s lacks '%s'" % (ev["action"], missing[0]) if missing else None
+
+
+# Checks across fields, for the kinds that have them: None when the event is right.
+_ACROSS: dict[str, Callable[[dict], "str | None"]] = {"structure": _structure_problem, "debug": _debug_problem}
+
+
 def validate(ev: Any) -> str | None:
     """What is wrong with ``ev``, in words; None when it is a well-formed event of this schema."""
     if type(ev) is dict:
         kind = ev.get("kind")
         fields = _KIND_FIELDS.get(kind) if type(kind) is str else None
-        if (fields is not None and _fits(ev, _ENVELOPE) and _fits(ev, fields)
-                and (kind != "structure" or ev["root"]["path"] == ev["path"])):
-            return None
+        if fields is not None and _fits(ev, _ENVELOPE) and _fits(ev, fields):
+            across = _ACROSS.get(kind)
+            if across is None or across(ev) is None:
+                return None
     return _problem(ev)
 
 
@@ -415,9 +466,8 @@ def _problem(ev: Any) -> str | None:
     problem = _fields_problem(ev, spec.fields, ev["kind"])
     if problem:
         return problem
-    if spec.name == "structure" and ev["root"]["path"] != ev["path"]:
-        return "structure.root.path %r differs from the event's path %r" % (ev["root"]["path"], ev["path"])
-    return None
+    across = _ACROSS.get(spec.name)
+    return across(ev) if across is not None else None
 
 
 # Graph element ids (docs/api.md). A path can hold any character; XML cannot hold control

@@ -45,6 +45,7 @@ class Status:
         # A preempt requested and not over yet: {"seq", "t", "path", "serviced": [paths that serviced it]}.
         self.preempt: dict | None = None
         self.pose: dict | None = None  # the last pose event's {seq, t, joints, bodies}
+        self.debug: dict | None = None  # the debugger's {mode, level, holds, breakpoints}, from its events
 
     def apply(self, event: dict) -> None:
         kind = event["kind"]
@@ -67,6 +68,9 @@ class Status:
             self.pose = {"seq": event["seq"], "t": event["t"], "joints": event["joints"],
                          "bodies": event.get("bodies", {})}
             return
+        if kind == "debug":
+            self._debug(event)
+            return
         if kind not in ("start", "transition", "userdata", "terminate", "error"):
             return
         entry = self.containers.get(path)
@@ -76,6 +80,8 @@ class Status:
         if kind == "start":
             if root:  # a new run: what the previous one reached no longer describes the machine
                 self.running, self.outcome, self.error, self.preempt = True, None, None, None
+                if self.debug is not None:  # a run never starts holding
+                    self.debug["holds"] = []
                 for other in self.containers.values():
                     other.update(active=[], running=False, outcome=None, last=None, changes={}, written=False)
             entry.update(active=list(event["active"]), initial=list(event["initial"]),
@@ -116,6 +122,25 @@ class Status:
         elif self.preempt is not None:
             self.preempt["serviced"].append(event["path"])
 
+    def _debug(self, event: dict) -> None:
+        """Mode, holds and breakpoints as the debugger's events say (a hold ends with its release)."""
+        debug = self.debug
+        if debug is None:
+            debug = self.debug = {"mode": "run", "level": None, "holds": [], "breakpoints": []}
+        action = event["action"]
+        if action == "mode":
+            debug["mode"], debug["level"] = event["mode"], event.get("level")
+        elif action == "breakpoints":
+            debug["breakpoints"] = event["breakpoints"]
+        elif action == "hold":
+            debug["mode"], debug["level"] = "pause", None
+            debug["holds"] = debug["holds"] + [{
+                "path": event["path"], "state": event["state"], "at": event["at"], "outcome": event.get("outcome"),
+                "reason": event["reason"], "detail": event["detail"], "seq": event["seq"]}]
+        elif action == "release":
+            held = [h for h in debug["holds"] if h["path"] == event["path"] and h["state"] == event["state"]]
+            debug["holds"] = [h for h in debug["holds"] if h is not held[0]] if held else debug["holds"]
+
     def preempt_waiting_on(self) -> list[str]:
         """The active states that have not serviced the pending preempt (none when there is none)."""
         if self.preempt is None:
@@ -144,7 +169,7 @@ class Status:
                 "containers": copy.deepcopy(self.containers), "running": self.running, "outcome": self.outcome,
                 "error": self.error, "last_seq": self.last_seq, "last_t": self.last_t, "run_seq": self.run_seq,
                 "preempt": None if self.preempt is None else dict(self.preempt, serviced=list(self.preempt["serviced"])),
-                "pose": self.pose}
+                "pose": self.pose, "debug": copy.deepcopy(self.debug)}
 
     def _load(self, data: dict) -> None:
         self.run = data.get("run")
@@ -159,6 +184,7 @@ class Status:
         self.run_seq = data.get("run_seq", 0)
         self.preempt = copy.deepcopy(data.get("preempt"))
         self.pose = data.get("pose")
+        self.debug = copy.deepcopy(data.get("debug"))
         for entry in self.containers.values():  # a snapshot of an older fsmscope lacks these
             entry.setdefault("last", None)
             entry.setdefault("changes", {})

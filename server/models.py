@@ -126,6 +126,32 @@ class PendingPreempt(BaseModel):
     serviced: list[str] = Field(description="the states that serviced it so far")
 
 
+class Breakpoint(BaseModel):
+    state: str = Field(description="the state's path")
+    at: str = Field(description="'before' it runs or 'after' it returned")
+    outcome: Optional[str] = Field(default=None, description="after: only this outcome")
+    when: Optional[str] = Field(default=None, description="a condition over its container's userdata")
+
+
+class Hold(BaseModel):
+    path: str = Field(description="the holding container")
+    state: str
+    at: str
+    outcome: Optional[str] = Field(default=None, description="at 'after': the outcome it will take")
+    reason: str = Field(description="pause, step or breakpoint")
+    detail: str = Field(description="in words")
+    seq: int = Field(description="the hold event's")
+
+
+class DebugState(BaseModel):
+    """The debugger's state as its events say (docs/debugging.md)."""
+
+    mode: str = Field(description="run, pause or step")
+    level: Optional[str] = Field(default=None, description="step: the container whose next transition ends it")
+    holds: list[Hold]
+    breakpoints: list[Breakpoint]
+
+
 class MachineStatus(BaseModel):
     """``fsm.observation.status.Status.to_dict()`` without ``structure``: now, or after event ``seq``."""
 
@@ -136,7 +162,7 @@ class MachineStatus(BaseModel):
                                     "last": {"from": "FOO", "outcome": "go", "to": "BAR", "seq": 4},
                                     "changes": {"visits": {"old": [], "new": ["FOO"]}}, "written": False}},
         "running": True, "outcome": None, "error": None, "last_seq": 4, "last_t": 1700000000.25, "run_seq": 1,
-        "preempt": None, "pose": None, "preempt_waiting_on": []}]})
+        "preempt": None, "pose": None, "debug": None, "preempt_waiting_on": []}]})
 
     machine: str
     run: Optional[str] = None
@@ -150,6 +176,7 @@ class MachineStatus(BaseModel):
     run_seq: int = Field(default=0, description="the seq of the current run's first event")
     preempt: Optional[PendingPreempt] = Field(default=None, description="a preempt requested and not over yet")
     pose: Optional[Pose] = Field(default=None, description="the robot's last recorded pose (a pose event)")
+    debug: Optional[DebugState] = Field(default=None, description="the debugger's state; null until a debug event")
     preempt_waiting_on: list[str] = Field(default_factory=list, description="the active states that have not "
                                           "serviced the pending preempt")
 

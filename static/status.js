@@ -55,6 +55,7 @@ export class Status {
     // A preempt requested and not over yet: {seq, t, path, serviced: [paths that serviced it]}.
     this.preempt = null;
     this.pose = null; // the last pose event's {seq, t, joints, bodies}
+    this.debug = null; // the debugger's {mode, level, holds, breakpoints}, from its events
   }
 
   apply(event) {
@@ -83,6 +84,10 @@ export class Status {
       this.pose = { seq: event.seq, t: event.t, joints: event.joints, bodies: event.bodies || {} };
       return;
     }
+    if (kind === "debug") {
+      this._debug(event);
+      return;
+    }
     if (!REDUCED.has(kind)) return;
     let entry = this.containers[path];
     if (entry === undefined) entry = this.containers[path] = containerEntry();
@@ -93,6 +98,7 @@ export class Status {
         this.outcome = null;
         this.error = null;
         this.preempt = null;
+        if (this.debug !== null) this.debug.holds = []; // a run never starts holding
         for (const other of Object.values(this.containers)) {
           Object.assign(other, { active: [], running: false, outcome: null, last: null, changes: {}, written: false });
         }
@@ -146,6 +152,28 @@ export class Status {
     }
   }
 
+  /** Mode, holds and breakpoints as the debugger's events say (fsm/observation/status.py's _debug). */
+  _debug(event) {
+    if (this.debug === null) this.debug = { mode: "run", level: null, holds: [], breakpoints: [] };
+    const debug = this.debug;
+    if (event.action === "mode") {
+      debug.mode = event.mode;
+      debug.level = event.level ?? null;
+    } else if (event.action === "breakpoints") {
+      debug.breakpoints = event.breakpoints;
+    } else if (event.action === "hold") {
+      debug.mode = "pause";
+      debug.level = null;
+      debug.holds = [...debug.holds, {
+        path: event.path, state: event.state, at: event.at, outcome: event.outcome ?? null,
+        reason: event.reason, detail: event.detail, seq: event.seq,
+      }];
+    } else if (event.action === "release") {
+      const held = debug.holds.find((h) => h.path === event.path && h.state === event.state);
+      if (held) debug.holds = debug.holds.filter((h) => h !== held);
+    }
+  }
+
   /** The active states that have not serviced the pending preempt (none when there is none). */
   preemptWaitingOn() {
     if (this.preempt === null) return [];
@@ -184,7 +212,7 @@ export class Status {
       machine: this.machine, run: this.run, root_path: this.root_path, structure: this.structure,
       containers: structuredClone(this.containers), running: this.running, outcome: this.outcome,
       error: this.error, last_seq: this.last_seq, last_t: this.last_t, run_seq: this.run_seq,
-      preempt: structuredClone(this.preempt), pose: this.pose,
+      preempt: structuredClone(this.preempt), pose: this.pose, debug: structuredClone(this.debug),
     };
   }
 
@@ -201,6 +229,7 @@ export class Status {
     this.run_seq = data.run_seq ?? 0;
     this.preempt = structuredClone(data.preempt ?? null);
     this.pose = data.pose ?? null;
+    this.debug = structuredClone(data.debug ?? null);
     for (const entry of Object.values(this.containers)) { // a snapshot of an older fsmscope lacks these
       entry.last ??= null;
       entry.changes ??= {};

@@ -19,6 +19,7 @@ import pytest
 from fsm.debugging import Debugger
 from fsm.logfiles.log_reader import read_events
 from fsm.observation import introspection
+from fsm.observation.status import Status
 from fsm.logfiles.transcript import Transcript
 
 from recording_support import EXAMPLES, FAST, cli, record
@@ -152,3 +153,26 @@ def test_the_browsers_transcript_of_a_run_is_the_terminals_line_for_line(page, t
     want = terminal_lines(events)
     assert want
     assert browser_lines(page, events) == want
+
+
+def test_the_browsers_reducer_follows_the_debuggers_events_as_the_terminals_does(page, tmp_path, logs):
+    path = tmp_path / "debugged.jsonl"
+    debugged_run(path)
+    events = list(read_events(path))
+    status, want = Status("m"), []
+    for event in events:
+        status.apply(event)
+        if event["kind"] == "debug":
+            want.append(status.to_dict()["debug"])
+    got = page.evaluate("""async (events) => {
+        const { Status } = await import('/status.js');
+        const status = new Status('m');
+        const seen = [];
+        for (const e of events) {
+            status.apply(e);
+            if (e.kind === 'debug') seen.push(status.toDict().debug);
+        }
+        return seen;
+    }""", events)
+    assert [d["holds"] for d in want if d["holds"]]  # the run held, and the reducers saw it
+    assert got == want

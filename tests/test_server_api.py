@@ -70,6 +70,29 @@ def test_structure_and_status_after_a_run(live_server):
     assert status["containers"]["/SM_ROOT"]["userdata"] == {"visits": ["FOO", "BAR"]}
 
 
+def test_the_status_says_where_a_debugged_machine_holds_and_why(live_server):
+    from fsm.debugging import Debugger
+
+    sm = two_state_machine()
+    live_server.hub.add_local(sm, name="two")
+    debugger = Debugger(sm)
+    debugger.set_breakpoints([{"state": "/SM_ROOT/BAR", "at": "before", "when": "len(visits) == 1"}])
+    thread, result = run_in_thread(sm)
+    try:
+        http = client(live_server)
+        wait_for(lambda: http.get("/api/machines/two/status").json()["debug"]["holds"])
+        debug = http.get("/api/machines/two/status").json()["debug"]
+        assert debug["mode"] == "pause"
+        assert [(h["state"], h["at"], h["detail"]) for h in debug["holds"]] == [
+            ("BAR", "before", "hit breakpoint before BAR when len(visits) == 1")]
+        assert debug["breakpoints"] == [{"state": "/SM_ROOT/BAR", "at": "before", "outcome": None,
+                                         "when": "len(visits) == 1"}]
+    finally:
+        debugger.detach()
+        thread.join(5)
+    assert result["outcome"] == "done"
+
+
 def test_unknown_machine_is_404(live_server):
     assert client(live_server).get("/api/machines/nope/status").status_code == 404
 

@@ -1,4 +1,8 @@
-"""Who may use the server: the token, the bind policy, and the token and Origin checks of the routes.
+"""Who may use the server: the tokens and their roles, the bind policy, and the token and Origin
+checks of the routes.
+
+Two tokens: the operator's (watch and control) and a viewer's (watch only: every GET and the
+stream, no control, no publishing), so that a view can be shared without handing out the controls.
 
 The token travels only where the page puts it: an ``Authorization: Bearer`` header, a
 websocket subprotocol ``fsmscope.token.TOKEN`` (browsers cannot set headers on a websocket),
@@ -39,10 +43,21 @@ def check_bind(host: str, token: str | None) -> None:
         raise ValueError("refusing to bind %s without a token: the dashboard can stop a machine" % host)
 
 
-def token_ok(settings: Settings, candidate: str | None) -> bool:
-    if not settings.token:
-        return True
-    return bool(candidate) and secrets.compare_digest(candidate.encode(), settings.token.encode())
+OPERATOR, VIEWER = "operator", "viewer"
+
+
+def _same(candidate: str | None, token: str | None) -> bool:
+    return bool(candidate) and bool(token) and secrets.compare_digest(candidate.encode(), token.encode())
+
+
+def role_of(settings: Settings, candidate: str | None) -> str | None:
+    """What a token makes its bearer: the operator (the token: watch and control), a viewer (the
+    viewer token: watch only), or nobody (None). Without a token everyone is the operator."""
+    if not settings.token or _same(candidate, settings.token):
+        return OPERATOR
+    if _same(candidate, settings.viewer_token):
+        return VIEWER
+    return None
 
 
 def own_origin(host_header: str | None) -> str:
@@ -56,15 +71,23 @@ def _bearer(headers: Any) -> str | None:
     return None
 
 
-def require_token(request: Request) -> None:
+def require_token(request: Request) -> str:
     """Dependency for everything under /api but health: 403 for a state change from another
-    origin, 401 without a valid token (Authorization: Bearer or ?token=)."""
+    origin, 401 without a valid token (Authorization: Bearer or ?token=); returns the role."""
     settings: Settings = request.app.state.settings
     origin = request.headers.get("origin")
     if request.method != "GET" and origin is not None and origin != own_origin(request.headers.get("host")):
         raise HTTPException(403, "cross-origin request refused")
-    if not token_ok(settings, _bearer(request.headers) or request.query_params.get("token")):
+    role = role_of(settings, _bearer(request.headers) or request.query_params.get("token"))
+    if role is None:
         raise HTTPException(401, "a valid token is required (Authorization: Bearer or ?token=)")
+    return role
+
+
+def require_operator(request: Request) -> None:
+    """Dependency for every control: require_token's checks, then 403 for a viewer's token."""
+    if require_token(request) != OPERATOR:
+        raise HTTPException(403, "this token is a viewer's: it may watch, not control (the operator's token may)")
 
 
 def websocket_token(websocket: WebSocket) -> str | None:
@@ -84,12 +107,16 @@ def websocket_subprotocol(websocket: WebSocket) -> str | None:
     return SUBPROTOCOL if SUBPROTOCOL in offered else None
 
 
-def websocket_refusal(websocket: WebSocket) -> tuple[int, str] | None:
-    """Origin (before accept) and token checks for a websocket; None when it may be accepted."""
+def websocket_refusal(websocket: WebSocket, operator: bool = False) -> tuple[int, str] | None:
+    """Origin (before accept) and token checks for a websocket; None when it may be accepted.
+    ``operator``: the socket controls (a publisher's ingest), so a viewer's token is refused."""
     settings: Settings = websocket.app.state.settings
     origin = websocket.headers.get("origin")
     if origin is not None and origin != own_origin(websocket.headers.get("host")):
         return 403, "websocket from a foreign origin refused"
-    if not token_ok(settings, websocket_token(websocket)):
+    role = role_of(settings, websocket_token(websocket))
+    if role is None:
         return 401, "a valid token is required"
+    if operator and role != OPERATOR:
+        return 403, "this token is a viewer's: it may watch, not publish"
     return None

@@ -56,24 +56,30 @@ class ServerThread:
 
     def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
                  log_level: str = "warning", scene_url: str | None = None,
-                 show_pose: Callable[[dict | None], None] | None = None) -> None:
+                 show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None) -> None:
         from .app import create_app
         import uvicorn
 
         self.token = new_token() if token is None else token
+        self.viewer_token = new_token() if viewer_token is None else viewer_token  # watch only (server/auth.py)
         check_bind(host, self.token)
         self.hub = hub if hub is not None else Hub()
         self.host = host
         self.sock = bind_socket(host, port)
         self.port = self.sock.getsockname()[1]
         self.app = create_app(self.hub, self.token, host=host, port=self.port, scene_url=scene_url,
-                              show_pose=show_pose)
+                              show_pose=show_pose, viewer_token=self.viewer_token if self.token else None)
         self.server = uvicorn.Server(uvicorn_config(self.app, log_level))
         self._thread: threading.Thread | None = None
 
     @property
     def url(self) -> str:
         return display_url(self.host, self.port, self.token)
+
+    @property
+    def viewer_url(self) -> str:
+        """The dashboard for someone who may watch and not control (no token: the same as ``url``)."""
+        return display_url(self.host, self.port, self.viewer_token if self.token else None)
 
     @property
     def base_url(self) -> str:

@@ -19,6 +19,12 @@ class Health(BaseModel):
     ok: bool = True
 
 
+class Session(BaseModel):
+    model_config = ConfigDict(json_schema_extra={"examples": [{"role": "viewer"}]})
+
+    role: str = Field(description="'operator' (watch and control) or 'viewer' (watch only)")
+
+
 class Scene(BaseModel):
     """Where the 3D view of the simulated robot is served (None: this server has none)."""
     url: str | None = None
@@ -259,6 +265,39 @@ class InitialStateRequest(BaseModel):
 
 class StartRequest(BaseModel):
     model_config = ConfigDict(extra="forbid")
+
+
+class StepRequest(BaseModel):
+    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"level": None}, {"level": "/SM_ROOT"}]})
+
+    level: Optional[str] = Field(default=None, max_length=4096, description="a container's path: hold again at "
+                                 "its next transition (a step over what runs inside it); null: the next anywhere")
+
+
+class ForceRequest(BaseModel):
+    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
+        {"state": "/SM_ROOT/PICK", "outcome": "succeeded"}]})
+
+    state: str = Field(max_length=4096, description="an active (or holding) state's path")
+    outcome: str = Field(max_length=1000, description="one of its registered outcomes")
+
+
+class BreakpointSpec(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    state: str = Field(max_length=4096, description="the state's path")
+    at: str = Field(default="before", description="'before' it runs or 'after' it returned")
+    outcome: Optional[str] = Field(default=None, max_length=1000, description="after: only this outcome")
+    when: Optional[str] = Field(default=None, max_length=1000, description="a condition over its container's "
+                                "userdata (docs/debugging.md): comparisons, and/or/not, in, len(), literals")
+
+
+class Breakpoints(BaseModel):
+    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"breakpoints": [
+        {"state": "/SM_ROOT/PICK/CLOSE", "at": "before", "when": "attempts > 2"},
+        {"state": "/SM_ROOT/PLACE", "at": "after", "outcome": "aborted"}]}]})
+
+    breakpoints: list[BreakpointSpec] = Field(max_length=1000, description="the whole set")
 
 
 class SeqResponse(BaseModel):

@@ -13,6 +13,7 @@ class Settings:
     and the routes (``scene_url``); ``port`` is None until the socket is bound."""
 
     token: str | None
+    viewer_token: str | None = None  # watch only (server/auth.py)
     host: str = "127.0.0.1"
     port: int | None = None
     max_body: int = MAX_BODY

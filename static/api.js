@@ -51,6 +51,8 @@ function query(params) {
 export const api = {
   machines: () => request("GET", "/api/machines"),
   scene: () => request("GET", "/api/scene"),
+  /** What this page's token lets it do: {role: "operator" | "viewer"}. */
+  session: () => request("GET", "/api/session"),
   status: (name) => request("GET", machine(name) + "/status"),
   /** The status right after event {seq}, or after the last event at time {t} (docs/api.md, "Time travel"). */
   statusAt: (name, at) => request("GET", machine(name) + "/status" + query(at)),

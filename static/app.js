@@ -87,6 +87,7 @@ const machines = new Machines($("machine-picker"), store, {
   },
 });
 const controls = new Controls(store, machines, notices, () => stream?.state === "live");
+api.session().then((s) => controls.setRole(s.role)).catch(() => {}); // no valid token: token.js says so
 const depth = new Depth($("depth"), store, () => graph.openPaths(), () => loadGraph());
 
 // ---------------------------------------------------------------- the machine shown and its stream

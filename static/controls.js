@@ -1,5 +1,6 @@
 // What controls the machine shown: Preempt, Start, "Stop after this run" and "Set as initial state…",
-// each disabled (the menu item saying why) when the server would refuse it.
+// each disabled (the menu item saying why) when the server would refuse it, and none of them shown
+// to a viewer (a page opened with the viewer's token: it may watch, not control).
 
 import { api } from "./api.js";
 import { confirmPreempt, editInitialState } from "./dialogs.js";
@@ -23,9 +24,21 @@ export class Controls {
     this.machines = machines;
     this.notices = notices;
     this.live = live;
+    this.viewer = false;
     $("preempt-btn").addEventListener("click", () => this._preempt());
     $("start-btn").addEventListener("click", () => this._ask("Start", api.start));
     $("hold-btn").addEventListener("click", () => this._ask("Stop after this run", api.hold, ": then the loop waits for Start"));
+  }
+
+  /** The page's role (api.session): a viewer sees no control. */
+  setRole(role) {
+    this.viewer = role === "viewer";
+    this.update();
+  }
+
+  /** Why the machine shown takes no control from this page now; "" when it does. */
+  refusal() {
+    return this.viewer ? "this page has a viewer's token: it may watch, not control" : controlRefusal(this.machines.current());
   }
 
   /** Enable what the machine shown accepts now; show whether its loop is held. */
@@ -33,11 +46,13 @@ export class Controls {
     const entry = this.machines.current();
     const running = this.store.status ? this.store.status.running : false;
     const live = this.machines.online && this.live();
-    const controllable = !controlRefusal(entry);
+    const controllable = !this.refusal();
     $("preempt-btn").disabled = !live || !running || !controllable;
     $("start-btn").disabled = !live || running || !controllable || !entry.can_start;
+    $("preempt-btn").hidden = this.viewer;
+    $("start-btn").hidden = this.viewer;
     const hold = $("hold-btn");
-    hold.hidden = !entry?.can_hold;
+    hold.hidden = this.viewer || !entry?.can_hold;
     hold.disabled = !live || !running || !controllable || entry.held;
     const loop = $("loop-state");
     loop.hidden = !entry?.held;
@@ -50,7 +65,7 @@ export class Controls {
     const node = nodes.get(path);
     const container = parentPath(path);
     const parent = container ? nodes.get(container) : null;
-    const refusal = controlRefusal(this.machines.current());
+    const refusal = this.refusal();
     const kind = parent ? containerKind(parent) : null;
     const takesInitial = kind === "StateMachine" || kind === "Sequence";
     return {

@@ -17,7 +17,7 @@ import threading
 import time
 from typing import Any
 
-from .serving import add_server_arguments, start_server
+from .serving import add_server_arguments, announce_viewer, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"
 PASSES_ARGUMENTS_ON = False
@@ -86,6 +86,7 @@ def main(args: argparse.Namespace) -> int:
             server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set,
                                  recording=record_path)
             print("fsmscope demo: open %s" % server.url, flush=True)
+            announce_viewer(args, server)
         print("fsmscope demo: recording to %s" % record_path, flush=True)
     except BaseException:
         demo.close()

@@ -7,7 +7,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING
 
-from .serving import add_server_arguments, start_server, wait_for_interrupt
+from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
     from ..runner import Runner
@@ -51,6 +51,7 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner) -> int:
                                                                    recording=runner.record_path))
     runner.keep_open = True  # runs started from the dashboard after the script ends are recorded too
     print("fsmscope: dashboard at %s" % srv.url, file=sys.stderr, flush=True)
+    announce_viewer(args, srv)
     try:
         code = runner.run()
         if not args.exit and runner.signalled is None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .serving import add_server_arguments, start_server, wait_for_interrupt
+from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 HELP = "serve the dashboard for machines of other processes (they publish to /api/ingest)"
 PASSES_ARGUMENTS_ON = False
@@ -20,6 +20,7 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 def main(args: argparse.Namespace) -> int:
     srv = start_server(args)
     print("fsmscope: serving the dashboard at %s" % srv.url, file=sys.stderr)
+    announce_viewer(args, srv)
     print("fsmscope: other processes publish with server.publisher.Publisher(%r, %r); Ctrl-C stops"
           % (srv.base_url, srv.token), file=sys.stderr, flush=True)
     wait_for_interrupt()

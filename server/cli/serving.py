@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import threading
 from typing import TYPE_CHECKING, Any
 
@@ -25,6 +26,9 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
                                                       ", a free one"))
     parser.add_argument("--token", default=os.environ.get("FSMSCOPE_TOKEN"),
                         help="the access token (default: $FSMSCOPE_TOKEN, else a random one per run)")
+    parser.add_argument("--viewer", action="store_true",
+                        help="also print a URL to share with someone who may watch and not control (a viewer's "
+                             "token, random per run)")
 
 
 def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
@@ -36,6 +40,12 @@ def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
         return ServerThread(host=args.host, port=args.port, token=args.token or None, **options).start()
     except (ValueError, OSError) as exc:
         raise CannotServe(str(exc)) from exc
+
+
+def announce_viewer(args: argparse.Namespace, srv: ServerThread) -> None:
+    """With --viewer, the watch-only URL on stderr (the operator's was printed just before)."""
+    if args.viewer:
+        print("fsmscope: viewer (watch only) at %s" % srv.viewer_url, file=sys.stderr, flush=True)
 
 
 def wait_for_interrupt() -> None:

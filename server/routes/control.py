@@ -11,9 +11,9 @@ from fastapi.concurrency import run_in_threadpool
 
 from .. import models
 from ..local_control import publish
-from .deps import AUTH, ERRORS, ClientAddress, Handle, HubDep
+from .deps import ERRORS, OPERATOR, ClientAddress, Handle, HubDep
 
-router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["control"])
+router = APIRouter(dependencies=OPERATOR, responses=ERRORS, tags=["control"])
 
 TOPIC = Path(min_length=1, max_length=200, pattern=r"^[A-Za-z0-9_.~/-]+$", description="topic name")
 

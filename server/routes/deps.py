@@ -8,7 +8,7 @@ from fastapi import Depends, HTTPException, Path, Request, WebSocket
 from starlette.requests import HTTPConnection
 
 from .. import models
-from ..auth import require_token, websocket_refusal
+from ..auth import require_operator, require_token, websocket_refusal
 from ..local_control import MachineHandle
 from ..hub import Hub, MachineEntry
 from ..middleware import deny_handshake
@@ -16,6 +16,7 @@ from ..middleware import deny_handshake
 ERRORS = {code: {"model": models.Error} for code in (400, 401, 403, 404, 409, 413, 422)}
 NAME = Path(min_length=1, max_length=200, description="machine name")
 AUTH = [Depends(require_token)]
+OPERATOR = [Depends(require_operator)]  # a control: a viewer's token is answered 403
 
 
 def get_hub(connection: HTTPConnection) -> Hub:
@@ -61,9 +62,10 @@ async def deny_websocket(websocket: WebSocket, status: int, detail: str) -> None
     await deny_handshake(websocket.scope, websocket._send, status, detail)
 
 
-async def refused(websocket: WebSocket) -> bool:
-    """The Origin and token checks of a websocket, before its handshake; True when it was refused."""
-    refusal = websocket_refusal(websocket)
+async def refused(websocket: WebSocket, operator: bool = False) -> bool:
+    """The Origin and token checks of a websocket, before its handshake; True when it was refused.
+    ``operator``: only the operator's token may open it."""
+    refusal = websocket_refusal(websocket, operator)
     if refusal is not None:
         await deny_websocket(websocket, *refusal)
     return refusal is not None

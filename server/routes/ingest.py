@@ -19,7 +19,7 @@ NOT_EVENTS = "frames must be JSON arrays of events"
 
 @router.websocket("/api/ingest")
 async def ingest(websocket: WebSocket, hub: HubDep) -> None:
-    if await refused(websocket):
+    if await refused(websocket, operator=True):
         return
     await websocket.accept(websocket_subprotocol(websocket))
     fed: set[str] = set()  # the machines this publisher feeds: shown disconnected when it leaves

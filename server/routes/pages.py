@@ -1,15 +1,19 @@
-"""The pages: the dashboard, the API's own documentation page, health and where the 3D view is."""
+"""The pages: the dashboard, the API's own documentation page, health, who the token makes its bearer,
+and where the 3D view is."""
 
 from __future__ import annotations
 
 import importlib.util
 import os
 
-from fastapi import APIRouter, Request
+from typing import Annotated
+
+from fastapi import APIRouter, Depends, Request
 from fastapi.openapi.docs import get_swagger_ui_html
 from fastapi.responses import FileResponse, HTMLResponse, Response
 
 from .. import models
+from ..auth import require_token
 from .deps import AUTH, ERRORS
 
 router = APIRouter()
@@ -55,3 +59,9 @@ async def health() -> models.Health:
 @router.get("/api/scene", response_model=models.Scene, dependencies=AUTH, responses=ERRORS, tags=["meta"])
 async def scene(request: Request) -> models.Scene:
     return models.Scene(url=request.app.state.settings.scene_url)
+
+
+@router.get("/api/session", response_model=models.Session, responses=ERRORS, tags=["meta"],
+            description="What the request's token lets it do: the page hides the controls of a viewer.")
+async def session(role: Annotated[str, Depends(require_token)]) -> models.Session:
+    return models.Session(role=role)

@@ -1,0 +1,65 @@
+"""Roles: the operator's token watches and controls, a viewer's token only watches (server/auth.py)."""
+
+import httpx
+import pytest
+from websockets.exceptions import InvalidStatus
+from websockets.sync.client import connect
+
+from server_support import client, frames, two_state_machine
+
+
+def viewer(srv):
+    return httpx.Client(base_url=srv.base_url, headers={"Authorization": "Bearer " + srv.viewer_token}, timeout=10)
+
+
+@pytest.fixture
+def served(live_server):
+    live_server.hub.add_local(two_state_machine(), name="two")
+    return live_server
+
+
+def test_each_token_says_its_role(served):
+    assert client(served).get("/api/session").json() == {"role": "operator"}
+    assert viewer(served).get("/api/session").json() == {"role": "viewer"}
+
+
+def test_a_viewer_reads_what_the_operator_reads(served):
+    for path in ("/api/machines", "/api/machines/two/status", "/api/machines/two/structure",
+                 "/api/machines/two/history", "/api/machines/two/breakpoints"):
+        assert viewer(served).get(path).status_code == 200, path
+
+
+@pytest.mark.parametrize("method, path, body", [
+    ("POST", "/api/machines/two/preempt", {}),
+    ("POST", "/api/machines/two/start", {}),
+    ("POST", "/api/machines/two/initial-state", {"states": ["BAR"]}),
+    ("POST", "/api/machines/two/pause", None),
+    ("POST", "/api/machines/two/resume", None),
+    ("POST", "/api/machines/two/step", None),
+    ("POST", "/api/machines/two/force", {"state": "/SM_ROOT/FOO", "outcome": "go"}),
+    ("PUT", "/api/machines/two/breakpoints", {"breakpoints": []}),
+    ("POST", "/api/topics/sm_stop", "stop"),
+])
+def test_a_viewers_control_is_403_saying_why(served, method, path, body):
+    response = viewer(served).request(method, path, json=body)
+    assert response.status_code == 403
+    assert "viewer's" in response.json()["detail"]
+
+
+def test_a_viewer_streams_the_machine(served):
+    url = "ws://127.0.0.1:%d/api/machines/two/stream?token=%s" % (served.port, served.viewer_token)
+    with connect(url, compression=None, open_timeout=5) as ws:
+        [snapshot] = frames(ws, lambda got: len(got) == 1)
+    assert snapshot["type"] == "snapshot"
+
+
+def test_a_viewer_cannot_publish_machines(served):
+    url = "ws://127.0.0.1:%d/api/ingest?token=%s" % (served.port, served.viewer_token)
+    with pytest.raises(InvalidStatus) as info:
+        connect(url, compression=None, open_timeout=5)
+    assert info.value.response.status_code == 403
+
+
+def test_an_unknown_token_is_still_401(served):
+    response = httpx.get(served.base_url + "/api/session", headers={"Authorization": "Bearer nope"})
+    assert response.status_code == 401

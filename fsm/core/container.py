@@ -25,6 +25,7 @@ class Container(State):
         self._start_cbs: list[tuple] = []
         self._transition_cbs: list[tuple] = []
         self._termination_cbs: list[tuple] = []
+        self._debugger = None  # read at every step: an attribute of its own is found faster than State's
 
     # What SMACH's error messages call this kind of container.
     _kind_name = "Container"

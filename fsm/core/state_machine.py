@@ -134,7 +134,15 @@ class StateMachine(Container):
             dbg = self._debugger
             outcome = dbg.before(self, last_state_label, state) if dbg is not None else None
             if outcome is None:
-                outcome = self._run_state(last_state_label, state, remapper)
+                try:  # inline, not a call of its own: this is every step
+                    outcome = state.execute(remapper)
+                except InvalidUserCodeError as ex:
+                    log.logerr("State '%s' failed to execute." % last_state_label)
+                    raise ex
+                except Exception as exc:
+                    raise introspection.carry_reported(InvalidUserCodeError(
+                        "Could not execute state '%s' of type '%s': " % (last_state_label, state)
+                        + traceback.format_exc()), exc) from exc
             dbg = self._debugger
             if dbg is not None:
                 outcome = dbg.after(self, last_state_label, state, outcome)
@@ -179,17 +187,6 @@ class StateMachine(Container):
             return target
         raise InvalidTransitionError("Outcome '%s' of state '%s' with transition target '%s' is neither a registered state nor a registered container outcome."
                                      % (str(outcome), str(last_state_label), str(target)))
-
-    @staticmethod
-    def _run_state(label: Any, state: State, remapper: Remapper) -> Any:
-        try:
-            return state.execute(remapper)
-        except InvalidUserCodeError as ex:
-            log.logerr("State '%s' failed to execute." % label)
-            raise ex
-        except Exception as exc:
-            raise introspection.carry_reported(InvalidUserCodeError(
-                "Could not execute state '%s' of type '%s': " % (label, state) + traceback.format_exc()), exc) from exc
 
     def _on_failure(self) -> Any:
         return self._failed_label

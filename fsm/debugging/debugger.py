@@ -31,7 +31,6 @@ from ..observation import introspection, structure
 from .breakpoint import Breakpoint, BreakpointError
 from .condition import ConditionError
 
-MODES = ("run", "pause", "step")
 POLL = 0.05  # s between looks at a preempt or a shutdown while holding
 _attached: "weakref.WeakKeyDictionary[Any, Debugger]" = weakref.WeakKeyDictionary()
 

@@ -12,7 +12,7 @@ import asyncio
 import hashlib
 import threading
 import time
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from fsm.observation import introspection, schema
 from fsm.observation import structure
@@ -22,6 +22,9 @@ from fsm.observation.status import Status
 from .local_control import MachineHandle
 from .fanout import Fanout, Feed, Observer
 from .history import History, LogHistory
+
+if TYPE_CHECKING:
+    from .remote_control import RemoteHandle
 
 
 def structure_hash(root: dict | None) -> str:
@@ -38,6 +41,7 @@ class MachineEntry(Feed):
         self.rejected = 0  # events refused at the door (ingest) for not fitting the schema
         self.connected: bool | None = None  # ingest: whether its publisher is connected (None: not ingested)
         self.handle: MachineHandle | None = None  # local machines only
+        self.remote: RemoteHandle | None = None  # ingested ones whose publisher takes controls (remote_control.py)
         self.replay: dict | None = None  # replayed from a log: {"speed": the page's initial play speed}
         self.reporter: introspection.Reporter | None = None
         self.observer: Observer | None = None

@@ -1,4 +1,5 @@
-"""Publish a machine's events to a standalone server (``fsmscope serve``) from another process.
+"""Publish a machine's events to a standalone server (``fsmscope serve``) from another process, and
+take its controls back.
 
     from server.publisher import Publisher
     fsm.attach(sm, Publisher("http://127.0.0.1:8765", token), name="picker")
@@ -15,24 +16,35 @@ At exit the publisher sends what it still holds (``close()`` runs from ``atexit`
 script that ends right after its machine does not leave the dashboard showing it running;
 ``with Publisher(url, token) as pub:`` closes it at the end of the block.
 
+Every machine attached to it takes the dashboard's controls (docs/debugging.md, "Remote machines"):
+the server sends ``control`` frames over the same connection, a worker thread applies them
+(server/publisher_control.py) and the sender answers each after the events it caused. While an
+operator holds a machine's lease, a connection lost for longer than the lease's ``after`` makes
+the publisher apply the deadman itself.
+
 Imports only the standard library, ``websockets`` and ``fsm`` (no FastAPI).
 """
 
 from __future__ import annotations
 
 import collections
+import queue
 import sys
 import threading
 import time
 import urllib.parse
 from typing import Any
 
-from fsm.observation import closing, schema
+from fsm.observation import closing, introspection, schema
 from fsm.observation.encoding import dumps, loads
 from fsm.observation.status import Status
 
+from .local_control import MachineHandle
+from .publisher_control import answer, apply_deadman, lease_of
+
 BUFFER = 100_000      # events held for the sender before the oldest are dropped
 MAX_BATCH = 2000      # events per frame
+DEADMAN_CLIENT = "publisher"  # the client of what the publisher does on its own
 
 
 def ingest_url(url: str, token: str | None) -> str:
@@ -49,16 +61,27 @@ def ingest_url(url: str, token: str | None) -> str:
 
 
 class Publisher:
-    """An observer (``fsm.attach(sm, Publisher(url, token))``) that forwards events to a server."""
+    """An observer (``fsm.attach(sm, Publisher(url, token))``) that forwards events to a server and
+    takes its controls; ``can_start``: whether the dashboard may run a machine again (in a new thread)."""
 
     def __init__(self, url: str, token: str | None = None, buffer: int = BUFFER, backoff_max: float = 5.0,
-                 start: bool = True) -> None:
+                 start: bool = True, can_start: bool = False) -> None:
         self.url = ingest_url(url, token)
+        self.can_start = can_start
         self._buf: collections.deque[dict] = collections.deque(maxlen=buffer)
         self._wake = threading.Event()
         self._stop = threading.Event()
         self._statuses: dict[str, Status] = {}
         self._backoff_max = backoff_max
+        self._handles: dict[str, MachineHandle] = {}  # the machines attached, by name: they take controls
+        self._handles_changed = 0  # bumped by each attach: the server is told again
+        self._controls: queue.Queue[tuple[int, dict] | None] = queue.Queue()
+        self._worker: threading.Thread | None = None
+        self._answers: collections.deque[tuple[int, str, int, dict]] = collections.deque()
+        self._deadman_lock = threading.Lock()
+        self._leases: dict[str, tuple[float, str]] = {}  # machine: (after, action) while a lease is held
+        self._outage = 0  # bumped at each connect: a deadman armed for an earlier outage does nothing
+        self._deadmen: list[threading.Timer] = []
         self.connected = threading.Event()
         self.sent = 0
         self.connects = 0
@@ -78,6 +101,12 @@ class Publisher:
         if not self._wake.is_set():
             self._wake.set()
 
+    def attached(self, reporter: introspection.Reporter) -> None:
+        """``fsm.attach`` gave this publisher a machine (Reporter.add_observer): it takes controls from now on."""
+        self._handles[reporter.machine] = MachineHandle(reporter.root, reporter, self.can_start)
+        self._handles_changed += 1
+        self._wake.set()
+
     def start(self) -> Publisher:
         if self._thread is None:
             self._thread = threading.Thread(target=self._run, name="fsmscope-publisher", daemon=True)
@@ -91,6 +120,9 @@ class Publisher:
             self.flush(max(0.0, deadline - time.monotonic()))
         self._stop.set()
         self._wake.set()
+        self._disarm()
+        if self._worker is not None:
+            self._controls.put(None)
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(max(0.1, deadline - time.monotonic()))
         closing.closed(self)
@@ -128,17 +160,14 @@ class Publisher:
                              status.root_path or "/SM_ROOT", {"status": status.to_dict()})
                 for name, status in self._statuses.items() if status.last_seq]
 
-    def _read_answers(self, ws: Any) -> None:
-        """Count the server's ``rejected`` frames (it sends nothing else) without waiting."""
-        while True:
-            try:
-                frame = loads(ws.recv(timeout=0))
-            except TimeoutError:
-                return
-            if type(frame) is dict and frame.get("type") == "rejected":
-                self.rejected += 1
-                sys.stderr.write("fsmscope publisher: the server refused event %s of %s: %s\n"
-                                 % (frame.get("seq"), frame.get("machine"), frame.get("reason")))
+    def _hello(self) -> str:
+        """Which machines take controls, sent first on every connection and again after an attach."""
+        self._announced = self._handles_changed
+        handles = dict(self._handles)
+        return dumps({"type": "hello", "controllable": sorted(handles),
+                      "can_start": {name: handle.can_start for name, handle in handles.items()}}).decode()
+
+    _announced = -1
 
     def _run(self) -> None:
         from websockets.sync.client import connect
@@ -153,32 +182,142 @@ class Publisher:
                 delay = min(delay * 2, self._backoff_max)
                 continue
             delay = 0.1
-            self.connects += 1
-            try:
-                with ws:
+            self._serve(ws)
+            if not self._stop.is_set():
+                self._arm()
+
+    def _serve(self, ws: Any) -> None:
+        """One connection: send events and answers until it is lost or the publisher stops."""
+        self.connects += 1
+        connection = self.connects
+        lost = threading.Event()
+        self._disarm()
+        if self._worker is None:
+            self._worker = threading.Thread(target=self._work, name="fsmscope-publisher-controls", daemon=True)
+            self._worker.start()
+        try:
+            with ws:
+                self._busy = True
+                ws.send(self._hello())
+                snapshots = self._snapshots()
+                if snapshots:
+                    ws.send(dumps(snapshots).decode())
+                self.connected.set()
+                threading.Thread(target=self._receive, args=(ws, connection, lost), name="fsmscope-publisher-receiver",
+                                 daemon=True).start()
+                while not self._stop.is_set() and not lost.is_set():
+                    if self._announced != self._handles_changed:
+                        ws.send(self._hello())
+                    batch = self._take()
+                    if batch:
+                        ws.send(dumps(batch).decode())
+                        self.sent += len(batch)
+                        self._send_answers(ws, connection, every=False)
+                        continue
+                    self._send_answers(ws, connection, every=True)
+                    self._busy = False
+                    self._wake.clear()
+                    if not self._buf and not self._answers:
+                        self._wake.wait(0.5)
                     self._busy = True
-                    snapshots = self._snapshots()
-                    if snapshots:
-                        ws.send(dumps(snapshots).decode())
-                    self.connected.set()
-                    while not self._stop.is_set():
-                        batch = self._take()
-                        if batch:
-                            ws.send(dumps(batch).decode())
-                            self.sent += len(batch)
-                            continue
-                        self._read_answers(ws)
-                        self._busy = False
-                        self._wake.clear()
-                        if not self._buf:
-                            self._wake.wait(0.5)
-                        self._busy = True
-            except Exception:
-                pass  # the server went away: reconnect
-            finally:
-                self._busy = False
-                self.connected.clear()
+        except Exception:
+            pass  # the server went away: reconnect
+        finally:
+            self._busy = False
+            self.connected.clear()
+
+    def _send_answers(self, ws: Any, connection: int, every: bool) -> None:
+        """Send the answers whose control events were sent (``every``: all of them, the buffer is
+        empty), so a page that reads the machine right after its answer finds them there."""
+        answers = self._answers
+        while answers:
+            asked_on, machine, due, frame = answers[0]
+            status = self._statuses.get(machine)
+            if asked_on == connection and not every and status is not None and status.last_seq < due:
+                return
+            answers.popleft()
+            if asked_on == connection:  # one asked on a connection since lost has nobody to go to
+                ws.send(dumps(frame).decode())
 
     def _take_all(self) -> None:
         while self._buf:
             self._take()
+
+    # The receiver thread (one per connection): what the server sends.
+    def _receive(self, ws: Any, connection: int, lost: threading.Event) -> None:
+        try:
+            for message in ws:
+                self._received(message, connection)
+        except Exception:
+            pass  # lost: the sender reconnects
+        finally:
+            lost.set()
+            self._wake.set()
+
+    def _received(self, message: str | bytes, connection: int) -> None:
+        """One frame from the server; one that is not JSON, or of no known type, is ignored."""
+        try:
+            frame = loads(message)
+        except (ValueError, RecursionError):
+            return
+        if type(frame) is not dict:
+            return
+        kind = frame.get("type")
+        if kind == "rejected":
+            self.rejected += 1
+            sys.stderr.write("fsmscope publisher: the server refused event %s of %s: %s\n"
+                             % (frame.get("seq"), frame.get("machine"), frame.get("reason")))
+        elif kind == "control":
+            self._controls.put((connection, frame))
+        elif kind == "lease":
+            said = lease_of(frame)
+            if said is not None and connection == self.connects:  # not a late frame of a connection since lost
+                with self._deadman_lock:
+                    if said[1] is None:
+                        self._leases.pop(said[0], None)
+                    else:
+                        self._leases[said[0]] = said[1]
+
+    # The control worker: applies controls in the order they came, off the sender and the machine.
+    def _work(self) -> None:
+        while True:
+            item = self._controls.get()
+            if item is None:
+                return
+            connection, frame = item
+            answered = answer(dict(self._handles), frame)
+            if answered is None:
+                continue
+            machine, reply = answered
+            handle = self._handles.get(machine)
+            due = handle.reporter.last_seq if handle is not None else 0
+            self._answers.append((connection, machine, due, reply))
+            self._wake.set()
+
+    # The deadman.
+    def _arm(self) -> None:
+        """The connection is lost: each machine whose lease is held gets its deadman's delay to reconnect."""
+        with self._deadman_lock:
+            for machine, (after, action) in self._leases.items():
+                timer = threading.Timer(after, self._deadman, (self._outage, machine, after, action))
+                timer.daemon = True
+                self._deadmen.append(timer)
+                timer.start()
+
+    def _disarm(self) -> None:
+        """Connected again (or closing): no deadman fires, and the server says the leases again."""
+        with self._deadman_lock:
+            self._outage += 1
+            for timer in self._deadmen:
+                timer.cancel()
+            self._deadmen = []
+            self._leases.clear()
+
+    def _deadman(self, outage: int, machine: str, after: float, action: str) -> None:
+        with self._deadman_lock:
+            if outage != self._outage or self._stop.is_set():
+                return
+        handle = self._handles.get(machine)
+        if handle is not None:
+            apply_deadman(handle, action, DEADMAN_CLIENT, "the connection to the dashboard was lost for %.1f s" % after,
+                          {"after": after})

@@ -55,8 +55,8 @@ def test_lists_machines(live_server):
     live_server.hub.add_local(two_state_machine(), name="two")
     [info] = client(live_server).get("/api/machines").json()
     assert info == {"name": "two", "running": False, "outcome": None, "last_seq": 0, "root_path": "/SM_ROOT",
-                    "can_start": True, "can_hold": False, "held": False, "source": "local", "connected": None,
-                    "rejected": 0, "replay": None}
+                    "can_start": True, "can_hold": False, "held": False, "source": "local", "controllable": True,
+                    "connected": None, "rejected": 0, "replay": None}
 
 
 def test_structure_and_status_after_a_run(live_server):
@@ -215,7 +215,7 @@ def test_control_requests_become_control_events(live_server):
     import json
     [event] = [json.loads(enc) for _, enc in entry.ring]
     assert (event["kind"], event["action"], event["reason"], event["result"], event["client"]) == \
-        ("control", "preempt", "why not", "not running", "127.0.0.1")
+        ("control", "preempt", "why not", "not running", "127.0.0.1 (operator)")
 
 
 def test_graph_svg_has_the_documented_ids(live_server):

@@ -51,10 +51,15 @@ class Reporter:
         return self._seq
 
     def add_observer(self, observer: Observer) -> None:
+        """An observer with an ``attached(reporter)`` method is then given this reporter: one that acts
+        on the machine too (a publisher that takes controls from afar) reaches it as ``reporter.root``."""
         # Replaced, never mutated: emit iterates the list it read without the lock.
         self._observers = self._observers + [observer]
         self._described_at = -1  # the newcomer has not seen the structure
         _set_listening(self, True)
+        attached = getattr(observer, "attached", None)
+        if callable(attached):
+            attached(self)
 
     def remove_observer(self, observer: Observer) -> None:
         # Equality, not identity: ``remove_observer(events.append)`` must match the bound method given to attach.

@@ -1,8 +1,10 @@
 """The door for other processes' machines: ``server.publisher.Publisher`` sends their events here
-(docs/api.md, "Ingest"); each is checked against the schema before it reaches the hub."""
+(docs/api.md, "Ingest"); each is checked against the schema before it reaches the hub. The same
+connection carries the controls of the machines its publisher said take them (server/remote_control.py)."""
 
 from __future__ import annotations
 
+import asyncio
 from typing import Any
 
 import orjson
@@ -10,6 +12,7 @@ from fastapi import APIRouter, WebSocket
 from starlette.websockets import WebSocketDisconnect
 
 from ..auth import websocket_subprotocol
+from ..remote_control import IngestLink
 from .deps import HubDep, refused
 
 router = APIRouter()
@@ -22,7 +25,7 @@ async def ingest(websocket: WebSocket, hub: HubDep) -> None:
     if await refused(websocket, operator=True):
         return
     await websocket.accept(websocket_subprotocol(websocket))
-    fed: set[str] = set()  # the machines this publisher feeds: shown disconnected when it leaves
+    link = IngestLink(hub, websocket.send_text, asyncio.get_running_loop())
     try:
         while True:
             message = await websocket.receive()
@@ -36,6 +39,12 @@ async def ingest(websocket: WebSocket, hub: HubDep) -> None:
             except orjson.JSONDecodeError:
                 await websocket.close(1007, NOT_EVENTS)
                 return
+            if isinstance(events, dict) and "type" in events:  # not an event: a hello or an answer
+                problem = _said(link, events)
+                if problem is not None:
+                    await websocket.close(1007, problem)
+                    return
+                continue
             if isinstance(events, dict):
                 events = [events]
             if not isinstance(events, list):
@@ -44,19 +53,24 @@ async def ingest(websocket: WebSocket, hub: HubDep) -> None:
             for event in events:
                 problem = hub.ingest(event)
                 if problem is None:
-                    fed.add(event["machine"])
-                    hub.get(event["machine"]).connected = True
+                    link.feeds(hub.get(event["machine"]))
                     continue
-                await websocket.send_text(orjson.dumps(
-                    {"type": "rejected", "reason": problem, "machine": _field(event, "machine"),
-                     "seq": _field(event, "seq")}).decode())
+                await link.send({"type": "rejected", "reason": problem, "machine": _field(event, "machine"),
+                                 "seq": _field(event, "seq")})
     except WebSocketDisconnect:
         return
     finally:
-        for name in fed:
-            entry = hub.get(name)
-            if entry is not None and entry.source == "ingest":
-                entry.connected = False
+        link.close()
+
+
+def _said(link: IngestLink, frame: dict) -> str | None:
+    """A publisher's frame other than events; returns why it closes the connection (None: taken)."""
+    kind = frame["type"]
+    if kind == "hello":
+        return link.hello(frame)
+    if kind == "answer":
+        return link.answer(frame)
+    return "unknown frame type %s" % ascii(kind)[:40]  # a close reason holds at most 123 bytes
 
 
 def _field(event: Any, name: str) -> Any:

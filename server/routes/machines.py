@@ -22,9 +22,11 @@ async def list_machines(hub: HubDep) -> list[dict]:
     for entry in hub.machines():
         status = entry.status
         handle = entry.handle
+        remote = entry.remote if entry.remote is not None and entry.remote.connected else None
+        can_start = handle.can_start if handle is not None else remote is not None and remote.can_start
         out.append({"name": entry.name, "running": entry.running(), "outcome": status.outcome,
-                    "last_seq": status.last_seq, "root_path": status.root_path,
-                    "can_start": bool(handle is not None and handle.can_start),
+                    "last_seq": status.last_seq, "root_path": status.root_path, "can_start": bool(can_start),
+                    "controllable": handle is not None or remote is not None,
                     "can_hold": bool(handle is not None and handle.holder is not None),
                     "held": bool(handle is not None and handle.held),
                     "source": entry.source, "connected": entry.connected, "rejected": entry.rejected,

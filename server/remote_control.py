@@ -1,0 +1,255 @@
+"""Controls of a machine that another process publishes (``server.publisher.Publisher``): the calls a
+``MachineHandle`` takes, sent as frames over that process's ingest websocket and answered by it
+(docs/api.md, "Ingest"). The publishing process applies them to its machine and emits the control
+events in its own stream, so they reach this server, its log and the pages like its other events.
+
+A call waits for the publisher's answer (at most ``ANSWER_TIMEOUT``): like a local control, it runs
+in a worker thread, never on the event loop.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import concurrent.futures
+import itertools
+import time
+from typing import TYPE_CHECKING, Any, Awaitable, Callable
+
+from pydantic import ValidationError
+
+from fsm.observation.encoding import dumps
+
+from .local_control import ControlError
+from .models import BreakpointSpec
+
+if TYPE_CHECKING:
+    from .hub import Hub, MachineEntry
+
+ANSWER_TIMEOUT = 5.0  # seconds a control waits for the publishing process's answer (then 504)
+LEASE_ACTIONS = ("pause", "preempt", "none")
+
+
+def not_connected(name: str) -> ControlError:
+    return ControlError(409, "the publishing process of %r is not connected: its controls are unavailable" % name)
+
+
+class IngestLink:
+    """One publisher's ingest connection, on the server's side: the machines it feeds, those it said
+    take controls (its ``hello``), and the controls waiting for its answer."""
+
+    def __init__(self, hub: Hub, send_text: Callable[[str], Awaitable[None]],
+                 loop: asyncio.AbstractEventLoop) -> None:
+        self.hub = hub
+        self.loop = loop
+        self.closed = False
+        self.fed: set[str] = set()  # the machines it feeds: shown disconnected when it leaves
+        self.controllable: dict[str, bool] = {}  # name: can_start, as its last hello said
+        self._send_text = send_text
+        self._send_lock = asyncio.Lock()
+        self._ids = itertools.count(1)
+        self._pending: dict[int, tuple[str, concurrent.futures.Future]] = {}
+
+    # On the loop.
+    async def send(self, frame: dict) -> None:
+        async with self._send_lock:  # one frame at a time: the route's answers and the controls share the socket
+            await self._send_text(dumps(frame).decode())
+
+    def feeds(self, entry: MachineEntry) -> None:
+        """An event of ``entry``'s machine came through this connection."""
+        entry.connected = True
+        if entry.name not in self.fed:
+            self.fed.add(entry.name)
+            self._bind(entry)
+
+    def hello(self, frame: dict) -> str | None:
+        """The publisher says which of its machines take controls; returns what is wrong with the frame."""
+        names, can_start = frame.get("controllable"), frame.get("can_start", {})
+        if type(names) is not list or any(type(name) is not str for name in names):
+            return "hello.controllable must be a list of machine names"
+        if type(can_start) is not dict:
+            return "hello.can_start must be an object"
+        self.controllable = {name: can_start.get(name) is True for name in names}
+        for name in self.fed:
+            self._bind(self.hub.get(name))
+        return None
+
+    def answer(self, frame: dict) -> str | None:
+        """The publisher's answer to a control; one nobody waits for any more (too late) is dropped."""
+        answer_id = frame.get("id")
+        if type(answer_id) is not int:
+            return "answer.id must be an integer"
+        waiting = self._pending.get(answer_id)
+        if waiting is not None and not waiting[1].done():
+            waiting[1].set_result(frame)
+        return None
+
+    def close(self) -> None:
+        """The connection ended: its machines are shown disconnected, their controls answer 409."""
+        self.closed = True
+        for name in self.fed:
+            entry = self.hub.get(name)
+            if entry is None or entry.source != "ingest":
+                continue
+            entry.connected = False
+            if entry.remote is not None and entry.remote.link is self:
+                entry.remote.link = None
+        for name, future in list(self._pending.values()):
+            if not future.done():
+                future.set_exception(not_connected(name))
+
+    def _bind(self, entry: MachineEntry | None) -> None:
+        if entry is None or entry.source != "ingest" or entry.name not in self.controllable:
+            return
+        if entry.remote is None:
+            entry.remote = RemoteHandle(entry)
+        entry.remote.bind(self)
+
+    # From any thread.
+    def post(self, frame: dict) -> None:
+        """Send ``frame`` without waiting (from the loop's thread too)."""
+        if not self.closed:
+            asyncio.run_coroutine_threadsafe(self.send(frame), self.loop)
+
+    # In a worker thread.
+    def ask(self, machine: str, action: str, params: dict, client: str) -> dict:
+        """Send a control and wait for its answer: the answer's frame when it took it (2xx), else
+        ControlError with the publisher's status and message (or 409/502/504 saying what failed)."""
+        answer_id = next(self._ids)
+        future: concurrent.futures.Future = concurrent.futures.Future()
+        self._pending[answer_id] = (machine, future)
+        deadline = time.monotonic() + ANSWER_TIMEOUT
+        try:
+            if self.closed:
+                raise not_connected(machine)
+            frame = {"type": "control", "id": answer_id, "machine": machine, "action": action, "params": params,
+                     "client": client}
+            try:
+                asyncio.run_coroutine_threadsafe(self.send(frame), self.loop).result(ANSWER_TIMEOUT)
+            except TimeoutError:
+                raise self._late(machine) from None
+            except Exception:  # the socket or the loop is gone
+                raise not_connected(machine) from None
+            try:
+                answer = future.result(max(0.0, deadline - time.monotonic()))
+            except TimeoutError:
+                raise self._late(machine) from None
+        finally:
+            self._pending.pop(answer_id, None)
+        status = answer.get("status")
+        if type(status) is int and 400 <= status < 500:
+            detail = answer.get("detail")
+            raise ControlError(status, detail if type(detail) is str else "refused by the publishing process")
+        if status not in (200, 202):
+            raise malformed(machine, "status %r" % (status,))
+        return answer
+
+    @staticmethod
+    def _late(machine: str) -> ControlError:
+        return ControlError(504, "the publishing process of %r did not answer within %g s" % (machine, ANSWER_TIMEOUT))
+
+
+def malformed(machine: str, what: str) -> ControlError:
+    return ControlError(502, "the publishing process of %r answered with a malformed %s" % (machine, what))
+
+
+class RemoteHandle:
+    """The controls of an ingested machine whose publisher takes them: the calls the routes make on a
+    MachineHandle and its DebugControl, each answered by the publishing process. Kept on the machine's
+    entry across reconnections (``link``: the connection now, None while its publisher is away)."""
+
+    def __init__(self, entry: MachineEntry) -> None:
+        self.entry = entry
+        self.name = entry.name
+        self.link: IngestLink | None = None
+        self._lease: dict | None = None  # the last lease frame: said again when the publisher comes back
+
+    def bind(self, link: IngestLink) -> None:
+        self.link = link
+        if self._lease is not None:
+            link.post(self._lease)
+
+    @property
+    def connected(self) -> bool:
+        link = self.link
+        return link is not None and not link.closed
+
+    @property
+    def can_start(self) -> bool:
+        link = self.link
+        return link is not None and link.controllable.get(self.name, False)
+
+    def is_running(self) -> bool:
+        return self.entry.running()
+
+    def debug_control(self) -> RemoteHandle:
+        """The debug routes' calls are this handle's own: the publisher holds the debugger."""
+        return self
+
+    def lease_changed(self, held: bool, after: float, action: str) -> None:
+        """Tell the publisher (server/lease.py calls this): while a lease is held, it applies ``action``
+        itself when its connection to this server is gone for ``after`` seconds."""
+        if action not in LEASE_ACTIONS:
+            raise ValueError("a deadman's action is one of %s, not %r" % (LEASE_ACTIONS, action))
+        self._lease = {"type": "lease", "machine": self.name, "held": bool(held), "after": float(after),
+                       "action": action}
+        link = self.link
+        if link is not None:
+            link.post(self._lease)
+
+    # The controls (docs/api.md): each the seq of the control event it caused in the publisher's stream.
+    def preempt(self, reason: str | None, client: str) -> int:
+        return self._seq("preempt", {"reason": reason}, client)
+
+    def hold(self, reason: str | None, client: str) -> int:
+        return self._seq("hold", {"reason": reason}, client)
+
+    def set_initial_state(self, path: str | None, states: list[str], userdata: dict | None, client: str) -> int:
+        return self._seq("initial-state", {"path": path, "states": states, "userdata": userdata or {}}, client)
+
+    def start(self, client: str) -> int:
+        return self._seq("start", {}, client)
+
+    def emit_control(self, action: str, client: str, result: str, reason: str | None = None,
+                     params: dict | None = None, path: str | None = None) -> int:
+        """A control event in the machine's stream, written by its publishing process (its seqs are its own)."""
+        return self._seq("record", {"action": action, "result": result, "reason": reason, "params": params or {},
+                                    "path": path}, client)
+
+    def pause(self, client: str) -> int:
+        return self._seq("pause", {}, client)
+
+    def resume(self, client: str) -> int:
+        return self._seq("resume", {}, client)
+
+    def step(self, level: str | None, client: str) -> int:
+        return self._seq("step", {"level": level}, client)
+
+    def force(self, state: str, outcome: str, client: str) -> int:
+        return self._seq("force", {"state": state, "outcome": outcome}, client)
+
+    def set_breakpoints(self, breakpoints: list[Any], client: str) -> list[dict]:
+        return self._breakpoints(self._ask("breakpoints", {"breakpoints": breakpoints}, client))
+
+    def breakpoints(self) -> list[dict]:
+        return self._breakpoints(self._ask("get-breakpoints", {}, ""))
+
+    def _ask(self, action: str, params: dict, client: str) -> dict:
+        link = self.link
+        if link is None or link.closed:
+            raise not_connected(self.name)
+        return link.ask(self.name, action, params, client)
+
+    def _seq(self, action: str, params: dict, client: str) -> int:
+        seq = self._ask(action, params, client).get("seq")
+        if type(seq) is not int or seq < 0:
+            raise malformed(self.name, "seq")
+        return seq
+
+    def _breakpoints(self, answer: dict) -> list[dict]:
+        listed = answer.get("breakpoints")
+        if type(listed) is not list:
+            raise malformed(self.name, "breakpoints list")
+        try:
+            return [BreakpointSpec.model_validate(bp).model_dump() for bp in listed]
+        except ValidationError:
+            raise malformed(self.name, "breakpoint") from None

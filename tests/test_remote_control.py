@@ -237,3 +237,9 @@ def test_a_control_frame_with_params_of_the_wrong_type_is_answered_422_and_one_w
     assert answer(handles, frame) == ("m", {"type": "answer", "id": 7, "status": 422,
                                             "detail": "params must be an object"})
     assert answer(handles, dict(frame, id="7")) is None
+
+
+def test_a_publishing_script_needs_no_web_framework():
+    loaded = subprocess.run([sys.executable, "-c", "import sys, server.publisher; print(' '.join(sys.modules))"],
+                            cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
+    assert [m for m in loaded if m.split(".")[0] in ("fastapi", "starlette", "pydantic", "uvicorn")] == []

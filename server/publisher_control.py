@@ -9,12 +9,12 @@ publishing script does not need FastAPI.
 
 from __future__ import annotations
 
-import math
 from typing import Any, Callable
 
 from .local_control import ControlError, MachineHandle
 
 LEASE_ACTIONS = ("pause", "preempt", "none")
+MAX_AFTER = 86400.0  # a deadman's delay longer than a day is not one (and would overflow a timer's wait)
 
 
 class Params:
@@ -110,7 +110,7 @@ def lease_of(frame: dict) -> tuple[str, tuple[float, str] | None] | None:
     machine, held, after, action = frame.get("machine"), frame.get("held"), frame.get("after"), frame.get("action")
     if type(machine) is not str or type(held) is not bool or action not in LEASE_ACTIONS:
         return None
-    if type(after) not in (int, float) or not math.isfinite(after) or after < 0:
+    if type(after) not in (int, float) or not 0 <= after <= MAX_AFTER:  # NaN fails the comparison too
         return None
     return machine, ((float(after), action) if held and action != "none" else None)
 

@@ -110,7 +110,7 @@ def test_a_preempt_over_rest_is_applied_and_recorded_by_the_publishing_process(p
     assert (event["kind"], event["action"], event["reason"], event["result"]) == ("control", "preempt", "stop the arm",
                                                                                    "accepted")
     wait_for(lambda: published.status()["outcome"] == "preempted")
-    wait_for(lambda: any(e.get("seq") == seq for e in published.own_events()))
+    wait_for(lambda: any((e["seq"], e["kind"]) == (seq, "control") for e in published.own_events()))
 
 
 def test_pause_step_and_resume_drive_the_published_machine(published):

@@ -20,35 +20,43 @@ from swagger_ui_bundle import swagger_ui_path
 
 from .local_control import ControlError
 from .hub import Hub
+from .lease import Deadman, Leases
+from .lease_control import LeaseControl
 from .middleware import SecurityMiddleware
-from .routes import control, debug, history, ingest, machines, pages, scene, stream, timeline
+from .routes import control, debug, history, ingest, lease, machines, pages, scene, stream, timeline
 from .settings import Settings
 
 
 def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int | None = None,
                title: str = "fsmscope", scene_url: str | None = None,
-               show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None) -> FastAPI:
+               show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None,
+               deadman: Deadman | None = None) -> FastAPI:
     """The dashboard's app; ``scene_url``: a 3D view served beside it (the sim demo's viser), or None;
     ``show_pose``: what draws a pose's fields in that view (None: back to live), for POST /api/scene/pose;
-    ``viewer_token``: a second token that may watch and not control (server/auth.py)."""
+    ``viewer_token``: a second token that may watch and not control (server/auth.py); ``deadman``: what a
+    machine does when its operator's page goes silent (server/lease.py; default: pause after 3 s)."""
+    leases = LeaseControl(hub, Leases(deadman or Deadman()))
 
     @contextlib.asynccontextmanager
     async def lifespan(app: FastAPI) -> AsyncIterator[None]:
         hub.bind_loop(asyncio.get_running_loop())
+        deadman_task = asyncio.create_task(leases.run_deadman())
         yield
+        deadman_task.cancel()
         await hub.close()
 
     app = _App(title=title, version="1", lifespan=lifespan, docs_url=None, redoc_url=None,
                description="Live view and control of fsm state machines (docs/api.md).")
     app.state.settings = Settings(token=token, viewer_token=viewer_token, host=host, port=port, scene_url=scene_url)
     app.state.hub = hub
+    app.state.leases = leases
     app.state.show_pose = show_pose
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(Exception, _unexpected_error)
     app.add_exception_handler(ControlError, _control_error)
     app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")  # for pages.docs
-    for module in (pages, machines, history, timeline, control, debug, scene, stream, ingest):
+    for module in (pages, machines, history, timeline, control, debug, lease, scene, stream, ingest):
         app.include_router(module.router)
     root = pages.static_dir()
     if root and os.path.isdir(root):

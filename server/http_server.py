@@ -12,6 +12,7 @@ from typing import Any, Callable
 
 from .auth import check_bind, new_token
 from .hub import Hub
+from .lease import Deadman
 
 
 def ws_implementation() -> str:
@@ -56,7 +57,8 @@ class ServerThread:
 
     def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
                  log_level: str = "warning", scene_url: str | None = None,
-                 show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None) -> None:
+                 show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None,
+                 deadman: Deadman | None = None) -> None:
         from .app import create_app
         import uvicorn
 
@@ -68,7 +70,8 @@ class ServerThread:
         self.sock = bind_socket(host, port)
         self.port = self.sock.getsockname()[1]
         self.app = create_app(self.hub, self.token, host=host, port=self.port, scene_url=scene_url,
-                              show_pose=show_pose, viewer_token=self.viewer_token if self.token else None)
+                              show_pose=show_pose, viewer_token=self.viewer_token if self.token else None,
+                              deadman=deadman)
         self.server = uvicorn.Server(uvicorn_config(self.app, log_level))
         self._thread: threading.Thread | None = None
 

@@ -7,10 +7,13 @@ worker thread, never on the event loop.
 from __future__ import annotations
 
 import threading
-from typing import Any, Callable
+from typing import TYPE_CHECKING, Any, Callable
 
 from fsm.observation import introspection
 from fsm.observation import structure
+
+if TYPE_CHECKING:
+    from .debug_control import DebugControl
 
 
 LAST_RUN_GRACE = 1.0  # seconds a start waits for this handle's previous run to return
@@ -64,6 +67,16 @@ class MachineHandle:
                                    {"action": action, "reason": reason, "client": client, "result": result,
                                     "params": params or {}})
         return event["seq"] if event is not None else self.reporter.last_seq
+
+    def lease_changed(self, held: bool, after: float, action: str) -> None:
+        """Nothing to tell: the server applies the deadman itself to a machine of its own process
+        (a remote machine's handle tells its publisher, server/remote_control.py)."""
+
+    def debug_control(self) -> DebugControl:
+        """Its debugger's controls: what the debug routes call on every kind of handle."""
+        from .debug_control import DebugControl  # that module builds on this one
+
+        return DebugControl(self)
 
     # Preempt (the /sm_stop of this world).
     def preempt(self, reason: str | None, client: str) -> int:

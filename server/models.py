@@ -59,6 +59,8 @@ class MachineInfo(BaseModel):
                            "after the current run")
     held: bool = Field(default=False, description="a hold was asked and no start has come since")
     source: Literal[SOURCES]  # type: ignore[valid-type]
+    controllable: bool = Field(default=False, description="its controls would be taken now: a machine of this "
+                               "process, or one whose publishing process takes them and is connected")
     connected: Optional[bool] = Field(default=None, description="a machine of another process: whether its "
                                       "publisher is connected (null for the others)")
     rejected: int = Field(default=0, description="events refused at the door for not fitting the schema")
@@ -298,6 +300,32 @@ class Breakpoints(BaseModel):
         {"state": "/SM_ROOT/PLACE", "at": "after", "outcome": "aborted"}]}]})
 
     breakpoints: list[BreakpointSpec] = Field(max_length=1000, description="the whole set")
+
+
+class LeaseHolder(BaseModel):
+    page: str = Field(description="the first characters of the holder page's id")
+    client: str = Field(description="where it asked from")
+    since: float = Field(description="when it took control (seconds since the epoch)")
+
+
+class Deadman(BaseModel):
+    after: float = Field(description="seconds without a heartbeat from the holder before the action")
+    action: Literal["pause", "preempt", "none"]
+
+
+class LeaseState(BaseModel):
+    """Who controls a machine (docs/debugging.md, "One operator at a time")."""
+
+    holder: Optional[LeaseHolder] = Field(default=None, description="null: nobody; a page's first control takes it")
+    yours: bool = Field(default=False, description="the page that asked (X-Fsmscope-Page) holds it")
+    deadman: Deadman
+    beat_every: float = Field(description="seconds between the holder page's heartbeats")
+
+
+class LeaseRequest(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    takeover: bool = Field(default=False, description="take it even when another page holds it (recorded)")
 
 
 class SeqResponse(BaseModel):

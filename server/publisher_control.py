@@ -11,9 +11,9 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from .lease import DEADMAN_ACTIONS
 from .local_control import ControlError, MachineHandle
 
-LEASE_ACTIONS = ("pause", "preempt", "none")
 MAX_AFTER = 86400.0  # a deadman's delay longer than a day is not one (and would overflow a timer's wait)
 
 
@@ -108,7 +108,7 @@ def lease_of(frame: dict) -> tuple[str, tuple[float, str] | None] | None:
     """What a ``lease`` frame says of its machine: (after, action) of the deadman to arm while the
     lease is held, or None to disarm it (released, or action none); None for a malformed frame."""
     machine, held, after, action = frame.get("machine"), frame.get("held"), frame.get("after"), frame.get("action")
-    if type(machine) is not str or type(held) is not bool or action not in LEASE_ACTIONS:
+    if type(machine) is not str or type(held) is not bool or action not in DEADMAN_ACTIONS:
         return None
     if type(after) not in (int, float) or not 0 <= after <= MAX_AFTER:  # NaN fails the comparison too
         return None

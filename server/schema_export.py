@@ -32,9 +32,8 @@ export const SCHEMA_VERSION = %(version)d;
 /** Every event kind. */
 export const KINDS = Object.freeze(%(kinds)s);
 
-/** Where a served machine's events come from, and which of those a dashboard may control. */
+/** Where a served machine's events come from. */
 export const SOURCES = Object.freeze(%(sources)s);
-export const CONTROLLABLE_SOURCES = Object.freeze(%(controllable)s);
 
 // Graph element ids: a path can hold any character; control characters and '%%' are
 // percent-escaped (one to one), as the server's SVG writes them.
@@ -65,7 +64,7 @@ export function containerKind(node) {
   return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
 }
 """ % {"version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
-       "sources": json.dumps({s: s for s in schema.SOURCES}), "controllable": json.dumps(list(schema.CONTROLLABLE_SOURCES)),
+       "sources": json.dumps({s: s for s in schema.SOURCES}),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
        "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),

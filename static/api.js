@@ -11,8 +11,15 @@ export class ApiError extends Error {
   }
 }
 
+/** This page's id, sent with every request: the operator lease (docs/debugging.md) is held by a page,
+ * not by a token, so that two tabs of one operator are two pages. Random per load. */
+export const PAGE_ID = Array.from(crypto.getRandomValues(new Uint8Array(12)), (b) => b.toString(16).padStart(2, "0")).join("");
+
+/** Headers of every request: the token's and this page's id. */
+const pageHeaders = () => ({ ...authHeaders(), "X-Fsmscope-Page": PAGE_ID });
+
 async function request(method, url, body, accept = "json") {
-  const init = { method, credentials: "omit", cache: "no-store", headers: authHeaders() };
+  const init = { method, credentials: "omit", cache: "no-store", headers: pageHeaders() };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
@@ -68,6 +75,20 @@ export const api = {
     request("POST", machine(name) + "/initial-state", { path, states, userdata }),
   start: (name) => request("POST", machine(name) + "/start", {}),
   hold: (name, reason) => request("POST", machine(name) + "/hold", { reason: reason || "" }),
+  pause: (name) => request("POST", machine(name) + "/pause"),
+  resume: (name) => request("POST", machine(name) + "/resume"),
+  /** One transition, then hold again; `level` a container's path: at its next transition (a step over). */
+  step: (name, level = null) => request("POST", machine(name) + "/step", { level }),
+  force: (name, state, outcome) => request("POST", machine(name) + "/force", { state, outcome }),
+  /** Replace the machine's whole set of breakpoints (docs/debugging.md). */
+  setBreakpoints: (name, breakpoints) => request("PUT", machine(name) + "/breakpoints", { breakpoints }),
+  /** Who controls the machine (docs/debugging.md): {holder, yours, deadman, beat_every}. */
+  lease: (name) => request("GET", machine(name) + "/lease"),
+  takeLease: (name, takeover) => request("POST", machine(name) + "/lease", { takeover }),
+  /** The lease holder's heartbeat, as heartbeat.js sends it: {url, headers} of a POST answered as lease()
+   * is, or 409 when this page lost the lease. */
+  beatRequest: (name) => ({ url: machine(name) + "/lease/beat", headers: pageHeaders() }),
+  releaseLease: (name) => request("DELETE", machine(name) + "/lease"),
   streamUrl(name, since) {
     const proto = location.protocol === "https:" ? "wss:" : "ws:";
     const qs = since ? "?since=" + encodeURIComponent(since) : "";

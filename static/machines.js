@@ -6,12 +6,12 @@ import { readLink, writeLink } from "./deeplink.js";
 import { holdChange } from "./loop.js";
 import { banner } from "./notice.js";
 import { h } from "./dom.js";
-import { CONTROLLABLE_SOURCES, SOURCES } from "./schema.js";
+import { SOURCES } from "./schema.js";
 
 const POLL_MS = 2000;
 
 const NOT_CONTROLLABLE = {
-  [SOURCES.ingest]: "this machine runs in another process: control it there",
+  [SOURCES.ingest]: "this machine runs in another process whose publisher takes no control: control it there",
   [SOURCES.replay]: "this machine is a recording being replayed: nothing to control",
 };
 
@@ -19,7 +19,8 @@ const NOT_CONTROLLABLE = {
  * the server would answer 409. Start and hold need the entry's `can_start` and `can_hold` too. */
 export function controlRefusal(entry) {
   if (!entry) return "no such machine on the server";
-  if (CONTROLLABLE_SOURCES.includes(entry.source)) return "";
+  if (entry.controllable) return "";
+  if (entry.connected === false) return "the process that publishes this machine is not connected: its controls are unavailable";
   return NOT_CONTROLLABLE[entry.source] || `a machine of source ${entry.source} cannot be controlled`;
 }
 

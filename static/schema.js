@@ -7,9 +7,8 @@ export const SCHEMA_VERSION = 1;
 /** Every event kind. */
 export const KINDS = Object.freeze(["structure", "start", "transition", "terminate", "userdata", "preempt", "error", "log", "feedback", "control", "debug", "pose", "snapshot"]);
 
-/** Where a served machine's events come from, and which of those a dashboard may control. */
+/** Where a served machine's events come from. */
 export const SOURCES = Object.freeze({"local": "local", "ingest": "ingest", "replay": "replay"});
-export const CONTROLLABLE_SOURCES = Object.freeze(["local"]);
 
 // Graph element ids: a path can hold any character; control characters and '%' are
 // percent-escaped (one to one), as the server's SVG writes them.

@@ -138,4 +138,4 @@ def test_every_debug_control_is_a_control_event_saying_who_and_the_result(loopin
     controls = [(e["action"], e["result"]) for e in events if e["kind"] == "control"]
     assert ("pause", "accepted") in controls
     assert any(action == "force" and "is not an outcome" in result for action, result in controls)
-    assert all(e["client"] == "127.0.0.1" for e in events if e["kind"] == "control")
+    assert all(e["client"] == "127.0.0.1 (operator)" for e in events if e["kind"] == "control")

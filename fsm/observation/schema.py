@@ -31,9 +31,8 @@ MAX_STRUCTURE_DEPTH = 64       # container levels; JSON encoders refuse much dee
 MAX_STRUCTURE_NODES = 200_000
 MAX_VALUE_DEPTH = 32           # nesting of a JSON value (userdata is cut at 16 levels when encoded)
 
-# Where a served machine's events come from, and which of those a dashboard may control.
+# Where a served machine's events come from (whether it takes controls is /api/machines' `controllable`).
 SOURCES = ("local", "ingest", "replay")
-CONTROLLABLE_SOURCES = ("local",)
 
 # Which of SMACH's containers a structure node is: its ``type`` when it is one of these, else (a
 # user's subclass) the kind whose own field it carries, else a state machine.
@@ -358,7 +357,9 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
     Kind("control", "Somebody asked the machine to do something.", (
         Field("action", STR, doc="preempt, initial-state, start, publish, ..."),
         Field("reason", OPT_STR, required=False, doc="the operator's words"),
-        Field("client", STR, doc="who asked (an address)"), Field("result", STR, doc="'accepted' or why not"),
+        Field("client", STR, doc="who asked: an address, the role and the page "
+                                 "('127.0.0.1 (operator, page 3f2a9c1d)'), or 'deadman'"),
+        Field("result", STR, doc="'accepted' or why not"),
         Field("params", OBJECT, required=False, doc="what was asked"))),
     Kind("debug", "The debugger (fsm.debugging) changed mode, held or released a transition, forced an outcome "
                   "or replaced its breakpoints; path is the container's (the root's for mode and breakpoints).", (

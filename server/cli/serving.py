@@ -9,6 +9,8 @@ import sys
 import threading
 from typing import TYPE_CHECKING, Any
 
+from ..lease import DEADMAN_ACTIONS, Deadman
+
 if TYPE_CHECKING:
     from ..http_server import ServerThread
 
@@ -29,6 +31,11 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
     parser.add_argument("--viewer", action="store_true",
                         help="also print a URL to share with someone who may watch and not control (a viewer's "
                              "token, random per run)")
+    parser.add_argument("--deadman", type=float, default=Deadman.after, metavar="SECONDS",
+                        help="when the page in control sends no heartbeat for this long, the machine does "
+                             "--deadman-action (default %(default)s)")
+    parser.add_argument("--deadman-action", choices=DEADMAN_ACTIONS, default=Deadman.action,
+                        help="what the machine does then: pause (default), preempt, or none")
 
 
 def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
@@ -37,7 +44,8 @@ def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
     from ..http_server import ServerThread
 
     try:
-        return ServerThread(host=args.host, port=args.port, token=args.token or None, **options).start()
+        return ServerThread(host=args.host, port=args.port, token=args.token or None,
+                            deadman=Deadman(args.deadman, args.deadman_action), **options).start()
     except (ValueError, OSError) as exc:
         raise CannotServe(str(exc)) from exc
 

@@ -11,7 +11,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from .. import models
 from ..local_control import publish
-from .deps import ERRORS, OPERATOR, ClientAddress, Handle, HubDep
+from .deps import ERRORS, LEASED, OPERATOR, ClientAddress, Handle, HubDep
 
 router = APIRouter(dependencies=OPERATOR, responses=ERRORS, tags=["control"])
 
@@ -34,14 +34,14 @@ async def hold(handle: Handle, client: ClientAddress,
     return models.SeqResponse(seq=await run_in_threadpool(handle.hold, reason, client))
 
 
-@router.post("/api/machines/{name}/initial-state", response_model=models.SeqResponse)
+@router.post("/api/machines/{name}/initial-state", response_model=models.SeqResponse, dependencies=LEASED)
 async def initial_state(handle: Handle, client: ClientAddress, body: models.InitialStateRequest) -> models.SeqResponse:
     seq = await run_in_threadpool(handle.set_initial_state, body.path, list(body.states), dict(body.userdata),
                                   client)
     return models.SeqResponse(seq=seq)
 
 
-@router.post("/api/machines/{name}/start", status_code=202, response_model=models.SeqResponse)
+@router.post("/api/machines/{name}/start", status_code=202, response_model=models.SeqResponse, dependencies=LEASED)
 async def start(handle: Handle, client: ClientAddress,
                 body: Annotated[models.StartRequest | None, Body()] = None) -> models.SeqResponse:
     return models.SeqResponse(seq=await run_in_threadpool(handle.start, client))

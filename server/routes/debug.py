@@ -11,33 +11,35 @@ from fastapi.concurrency import run_in_threadpool
 
 from .. import models
 from ..debug_control import DebugControl
-from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Handle
+from ..remote_control import RemoteHandle
+from .deps import AUTH, ERRORS, LEASED, OPERATOR, ClientAddress, Handle
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["debug"])
 
 
-def get_debug(handle: Handle) -> DebugControl:
-    return DebugControl(handle)
+def get_debug(handle: Handle) -> DebugControl | RemoteHandle:
+    """The debugger's controls of the machine: in this process, or asked of its publishing process."""
+    return handle.debug_control()
 
 
-Debug = Annotated[DebugControl, Depends(get_debug)]
+Debug = Annotated[DebugControl | RemoteHandle, Depends(get_debug)]
 
 
 @router.post("/api/machines/{name}/pause", status_code=202, response_model=models.SeqResponse,
-             dependencies=OPERATOR,
+             dependencies=OPERATOR + LEASED,
              description="Hold at the next transition boundary anywhere: the running state runs on until it returns.")
 async def pause(debug: Debug, client: ClientAddress) -> models.SeqResponse:
     return models.SeqResponse(seq=await run_in_threadpool(debug.pause, client))
 
 
 @router.post("/api/machines/{name}/resume", status_code=202, response_model=models.SeqResponse,
-             dependencies=OPERATOR)
+             dependencies=OPERATOR + LEASED)
 async def resume(debug: Debug, client: ClientAddress) -> models.SeqResponse:
     return models.SeqResponse(seq=await run_in_threadpool(debug.resume, client))
 
 
 @router.post("/api/machines/{name}/step", status_code=202, response_model=models.SeqResponse,
-             dependencies=OPERATOR,
+             dependencies=OPERATOR + LEASED,
              description="Let one transition happen, then hold again (409 when the machine is not paused).")
 async def step(debug: Debug, client: ClientAddress,
                body: Annotated[models.StepRequest | None, Body()] = None) -> models.SeqResponse:
@@ -46,7 +48,7 @@ async def step(debug: Debug, client: ClientAddress,
 
 
 @router.post("/api/machines/{name}/force", status_code=202, response_model=models.SeqResponse,
-             dependencies=OPERATOR,
+             dependencies=OPERATOR + LEASED,
              description="The state ends with this outcome: asked to preempt if it runs, taken at once if it holds "
                          "(422 for an unknown state or outcome, 409 when the state is not active).")
 async def force(debug: Debug, client: ClientAddress, body: models.ForceRequest) -> models.SeqResponse:
@@ -55,10 +57,11 @@ async def force(debug: Debug, client: ClientAddress, body: models.ForceRequest) 
 
 @router.get("/api/machines/{name}/breakpoints", response_model=models.Breakpoints)
 async def breakpoints(debug: Debug) -> models.Breakpoints:
-    return models.Breakpoints(breakpoints=[models.BreakpointSpec(**bp) for bp in debug.breakpoints()])
+    listed = await run_in_threadpool(debug.breakpoints)  # a remote machine's wait for its publisher's answer
+    return models.Breakpoints(breakpoints=[models.BreakpointSpec(**bp) for bp in listed])
 
 
-@router.put("/api/machines/{name}/breakpoints", response_model=models.Breakpoints, dependencies=OPERATOR,
+@router.put("/api/machines/{name}/breakpoints", response_model=models.Breakpoints, dependencies=OPERATOR + LEASED,
             description="Replace the whole set, all or none (422 saying which breakpoint is wrong and, for a "
                         "condition, at which column).")
 async def set_breakpoints(debug: Debug, client: ClientAddress, body: models.Breakpoints) -> models.Breakpoints:

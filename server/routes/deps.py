@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from typing import Annotated
 
 from fastapi import Depends, HTTPException, Path, Request, WebSocket
@@ -11,7 +12,10 @@ from .. import models
 from ..auth import require_operator, require_token, websocket_refusal
 from ..local_control import MachineHandle
 from ..hub import Hub, MachineEntry
+from ..lease import LeaseHeld
+from ..lease_control import LeaseControl
 from ..middleware import deny_handshake
+from ..remote_control import RemoteHandle, not_connected
 
 ERRORS = {code: {"model": models.Error} for code in (400, 401, 403, 404, 409, 413, 422)}
 NAME = Path(min_length=1, max_length=200, description="machine name")
@@ -37,24 +41,67 @@ def get_machine(name: Annotated[str, NAME], hub: HubDep) -> MachineEntry:
 Machine = Annotated[MachineEntry, Depends(get_machine)]
 
 
-def get_handle(entry: Machine) -> MachineHandle:
-    """The control handle of the machine the path names; 409 when it is not in this process."""
-    if entry.handle is None:
-        if entry.source == "replay":
-            raise HTTPException(409, "machine %r is a recording being replayed: nothing to control" % entry.name)
+def get_handle(entry: Machine) -> MachineHandle | RemoteHandle:
+    """The control handle of the machine the path names: its own in this process, or its publisher's
+    (remote_control.py); 409 when nothing takes its controls now."""
+    if entry.handle is not None:
+        return entry.handle
+    if entry.source == "replay":
+        raise HTTPException(409, "machine %r is a recording being replayed: nothing to control" % entry.name)
+    if entry.remote is None:
         raise HTTPException(409, "machine %r runs in another process: control it there" % entry.name)
-    return entry.handle
+    if not entry.remote.connected:
+        raise not_connected(entry.name)
+    return entry.remote
 
 
-Handle = Annotated[MachineHandle, Depends(get_handle)]
+Handle = Annotated[MachineHandle | RemoteHandle, Depends(get_handle)]
 
 
-def client_address(request: Request) -> str:
-    """Who asked, for the ``client`` of the control event a request causes."""
-    return request.client.host if request.client else ""
+PAGE_HEADER = "x-fsmscope-page"  # the page a request comes from (static/api.js PAGE_ID): who holds a lease
+PAGE_ID = re.compile(r"^[A-Za-z0-9_-]{1,64}$")
+
+
+def page_of(request: Request) -> str | None:
+    """The page a request comes from; None for a script that sends none."""
+    page = request.headers.get(PAGE_HEADER)
+    if page is None:
+        return None
+    if not PAGE_ID.match(page):
+        raise HTTPException(422, "the X-Fsmscope-Page header must be 1 to 64 letters, digits, '-' or '_'")
+    return page
+
+
+Page = Annotated[str | None, Depends(page_of)]
+
+
+def client_address(request: Request, role: Annotated[str, Depends(require_token)], page: Page) -> str:
+    """Who asked, for the ``client`` of the control event a request causes: the address, the role,
+    and the page (the lease's holder, when it is one), e.g. "127.0.0.1 (operator, page 3f2a9c1d)"."""
+    address = request.client.host if request.client else ""
+    return "%s (%s%s)" % (address, role, ", page %s" % page[:8] if page else "")
 
 
 ClientAddress = Annotated[str, Depends(client_address)]
+
+
+def get_leases(connection: HTTPConnection) -> LeaseControl:
+    return connection.app.state.leases
+
+
+Leases = Annotated[LeaseControl, Depends(get_leases)]
+
+
+def require_lease(entry: Machine, handle: Handle, page: Page, client: ClientAddress, leases: Leases) -> None:
+    """Dependency of a control that needs the operator lease (server/lease.py): 409 saying who holds it
+    when another page does; a page's first control takes a free one."""
+    try:
+        leases.admit(entry, page, client)
+    except LeaseHeld as err:
+        raise HTTPException(409, str(err)) from None
+
+
+LEASED = [Depends(require_lease)]
 
 
 async def deny_websocket(websocket: WebSocket, status: int, detail: str) -> None:

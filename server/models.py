@@ -217,7 +217,7 @@ class TimelineRun(TimelinePoint):
 
 
 class TimelineTick(TimelinePoint):
-    kind: Literal["error", "preempt", "control", "run"]
+    kind: Literal["error", "preempt", "control", "debug", "run"]
     text: str = Field(description="a short description, at most 200 characters")
 
 

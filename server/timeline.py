@@ -18,6 +18,8 @@ from __future__ import annotations
 from array import array
 from bisect import bisect_left, bisect_right
 
+from fsm.logfiles.transcript import debug_message
+
 MAX_MARKS = 1_000_000     # transitions kept in full detail (per machine) before the older half is coalesced
 COARSE_BUCKETS = 10_000   # buckets the coalesced part keeps
 MAX_TICKS = 100_000       # ticks (and run starts) kept, newest first
@@ -27,7 +29,8 @@ SEVERAL = "+"             # a Concurrence with several children running
 MANY = "…"                # several states within one bucket
 
 _MARKS = frozenset(("start", "transition", "terminate"))
-_TICKS = frozenset(("error", "preempt", "control"))
+_TICKS = frozenset(("error", "preempt", "control", "debug"))
+_DEBUG_TICKS = frozenset(("mode", "hold", "forced"))  # a release follows every hold: its tick would say nothing new
 
 
 class _Track:
@@ -81,6 +84,10 @@ def _tick_text(event: dict, kind: str) -> str | None:
         if event["phase"] != "requested":
             return None
         text = "preempt requested of " + event["path"]
+    elif kind == "debug":
+        if event["action"] not in _DEBUG_TICKS:
+            return None
+        text = debug_message(event)[1]
     else:
         result, reason = event["result"], event.get("reason")
         text = event["action"] + ("" if result == "accepted" else " (%s)" % result) + (": " + reason if reason else "")

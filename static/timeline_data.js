@@ -4,7 +4,7 @@
 
 export const NO_LABEL = -1; // null: the container is not running
 export const MANY = -2; // "…": many states within one bucket
-export const TICK_KINDS = ["error", "preempt", "control", "run"];
+export const TICK_KINDS = ["error", "preempt", "control", "debug", "run"];
 
 const segments = (path) => path.split("/").filter(Boolean);
 

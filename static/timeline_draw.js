@@ -14,7 +14,7 @@ const COLOURS = {
   outside: "#f1f2f4", selected: "#e8efff", playhead: "#2563eb", live: "#16a34a", run: "#7c3aed",
   several: "#cbd5e1", range: "rgba(37, 99, 235, .14)",
 };
-const TICK_COLOURS = ["#c62828", "#ea780c", "#2563eb", "#7c3aed"]; // error, preempt, control, run
+const TICK_COLOURS = ["#c62828", "#ea780c", "#2563eb", "#0d9488", "#7c3aed"]; // error, preempt, control, debug, run
 const AXIS_STEPS = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2, 5, 10, 15, 30, 60, 120, 300,
   600, 900, 1800, 3600, 7200, 10800, 21600, 43200, 86400];
 const MIN_LABEL_SPACING = 110; // px between two time labels

@@ -2,6 +2,7 @@
 container, ticks, zoom and its bounds, against a real uvicorn and real machines."""
 
 import random
+import threading
 
 import fsm
 import pytest
@@ -87,6 +88,26 @@ def test_a_preempt_asked_from_the_page_is_a_control_tick_and_a_preempt_tick(live
     ticks = [(tick["kind"], tick["text"]) for tick in timeline(live_server, "waiting")["ticks"]]
     assert ("control", "preempt: enough") in ticks
     assert ("preempt", "preempt requested of /SM_ROOT") in ticks
+
+
+def test_a_breakpoint_hit_and_a_forced_outcome_are_debug_ticks_in_the_transcripts_words(live_server):
+    from fsm.debugging import debugger_of
+
+    sm = machine(["done"], [("A", sleeper(0.01), {"go": "B"}), ("B", sleeper(0.01), {"go": "done"})])
+    served(live_server, sm, "debugged")
+    debugger = debugger_of(sm)
+    debugger.set_breakpoints([{"state": "/SM_ROOT/B", "at": "before"}], by="tester")
+    runner = threading.Thread(target=sm.execute)
+    runner.start()
+    try:
+        wait_for(lambda: debugger.holds(), 5, what="the breakpoint to hold")
+        debugger.force("/SM_ROOT/B", "go", by="tester")
+    finally:
+        debugger.detach()
+        runner.join(5)
+    texts = [tick["text"] for tick in timeline(live_server, "debugged")["ticks"] if tick["kind"] == "debug"]
+    hold = texts.index("Holding before 'B': hit breakpoint before B")
+    assert texts.index("Forced outcome 'go' of 'B' (it did not run) by tester") > hold
 
 
 def test_a_machine_with_no_events_has_an_empty_timeline(live_server):

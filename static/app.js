@@ -5,8 +5,10 @@
 
 import { api } from "./api.js";
 import { showBadge } from "./badge.js";
+import { Breakpoints, debugMarks } from "./breakpoints.js";
 import { readLink, writeLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
+import { DebugBar } from "./debugger.js";
 import { Depth } from "./depth.js";
 import { showMenu } from "./dialogs.js";
 import { GraphView } from "./graph.js";
@@ -88,6 +90,9 @@ const machines = new Machines($("machine-picker"), store, {
 });
 const controls = new Controls(store, machines, notices, () => stream?.state === "live");
 api.session().then((s) => controls.setRole(s.role)).catch(() => {}); // no valid token: token.js says so
+const showsLive = () => stream?.state === "live" && !playhead.past; // the debugger controls only what it shows
+const breakpoints = new Breakpoints(store, controls, showsLive);
+const debugBar = new DebugBar(store, controls, showsLive);
 const depth = new Depth($("depth"), store, () => graph.openPaths(), () => loadGraph());
 
 // ---------------------------------------------------------------- the machine shown and its stream
@@ -216,6 +221,7 @@ function stateMenu(path, x, y) {
   select(path);
   showMenu(x, y, path, [
     controls.initialStateItem(path),
+    ...breakpoints.items(path),
     { label: node && node.container ? "Show userdata" : "Show container userdata", action: () => {
       userdata.show(node?.container ? path : parentPath(path));
       queueRender();
@@ -228,6 +234,7 @@ function stateMenu(path, x, y) {
 
 function updateTopBar() {
   controls.update();
+  debugBar.update(shownStatus());
   showRunState($("run-state"), shownStatus(), machines.current());
 }
 
@@ -298,8 +305,9 @@ function render() {
   if (!store.status) return;
   const s = shownStatus();
   const shown = view(s);
-  graph.apply({ ...shown, selected: store.selected });
-  tree.update(s, shown.failed);
+  const marks = debugMarks(s);
+  graph.apply({ ...shown, ...marks, selected: store.selected });
+  tree.update(s, shown.failed, marks);
   if (playhead.past && !playhead.window) log.freeze();
   else log.showPast(playhead.past ? playhead.window : null);
   log.flush();

@@ -26,8 +26,8 @@ export class Controls {
     this.live = live;
     this.viewer = false;
     $("preempt-btn").addEventListener("click", () => this._preempt());
-    $("start-btn").addEventListener("click", () => this._ask("Start", api.start));
-    $("hold-btn").addEventListener("click", () => this._ask("Stop after this run", api.hold, ": then the loop waits for Start"));
+    $("start-btn").addEventListener("click", () => this.ask("Start", api.start));
+    $("hold-btn").addEventListener("click", () => this.ask("Stop after this run", api.hold, ": then the loop waits for Start"));
   }
 
   /** The page's role (api.session): a viewer sees no control. */
@@ -98,12 +98,14 @@ export class Controls {
     }
   }
 
-  /** Ask the server for `what` by `call(name)`; a notice says how it answered. */
-  async _ask(what, call, then = "") {
+  /** Ask the server for `what` by `call(name)` (the debugger's controls too); a notice says how it
+   * answered: the event the control caused, or the server's refusal (a 409 says why). */
+  async ask(what, call, then = "") {
     const name = this.store.name;
     try {
       const ack = await call(name);
-      this._say(name, `${what} accepted (event ${ack.seq})${then}`, "ok");
+      const event = ack.seq === undefined ? "" : ` (event ${ack.seq})`;
+      this._say(name, `${what} accepted${event}${then}`, "ok");
     } catch (err) {
       this._say(name, `${what} failed: ` + (err.detail || err.message), "error", true);
     }

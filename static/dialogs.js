@@ -1,5 +1,7 @@
-// Modal dialogs (preempt confirmation, set-initial-state editor) and the context menu.
-// Texts go in with textContent; the userdata editor validates its JSON before sending.
+// Modal dialogs (preempt confirmation, set-initial-state editor, breakpoint editor) and the context
+// menu. Texts go in with textContent; the userdata editor validates its JSON before sending.
+
+import { h } from "./dom.js";
 
 /** Ask to confirm a preempt; resolves to {reason} or null when cancelled. */
 export function confirmPreempt(machine) {
@@ -32,34 +34,33 @@ function parseUserdata(text) {
 }
 
 /**
- * The set-initial-state editor.
- * @param {object} opts {container, state, userdata, submit(userdata) -> Promise (rejects with an Error whose message is shown)}
- * @returns {Promise<boolean>} true when the server accepted it
+ * Show the modal `dialog` (a <form method="dialog"> with a button value="send" and a .dlg-error)
+ * until it is cancelled or `submit` succeeds. `read()` gives the form's {value} or an {error}
+ * (shown, and "send" disabled), after every input. A rejected `submit(value)` shows its message and
+ * leaves the dialog open to be corrected. Enter in a one-line field sends, never cancels.
+ * @returns {Promise<boolean>} true when `submit` succeeded
  */
-export function editInitialState({ container, state, userdata, submit }) {
-  const dialog = document.getElementById("initial-dialog");
+function formDialog(dialog, read, submit) {
   const form = dialog.querySelector("form");
-  const area = dialog.querySelector("textarea");
   const error = dialog.querySelector(".dlg-error");
   const send = dialog.querySelector("button[value=send]");
-  dialog.querySelector(".dlg-what").textContent = `Start ${container} in state ${state}`;
-  area.value = JSON.stringify(userdata || {}, null, 2);
-  error.textContent = "";
-  const validate = () => {
-    const parsed = parseUserdata(area.value);
+  const check = () => {
+    const parsed = read();
     error.textContent = parsed.error || "";
-    area.classList.toggle("invalid", Boolean(parsed.error));
     send.disabled = Boolean(parsed.error);
     return parsed;
   };
-  validate();
+  check();
   return new Promise((resolve) => {
-    const onInput = () => validate();
-    const onSubmit = async (e) => {
-      const which = e.submitter?.value;
-      if (which !== "send") return; // cancel: let the dialog close
+    const onKey = (e) => {
+      if (e.key !== "Enter" || e.target.localName !== "input") return;
       e.preventDefault();
-      const parsed = validate();
+      if (!send.disabled) form.requestSubmit(send);
+    };
+    const onSubmit = async (e) => {
+      if (e.submitter?.value !== "send") return; // cancel: let the dialog close
+      e.preventDefault();
+      const parsed = check();
       if (parsed.error) return;
       send.disabled = true;
       try {
@@ -76,17 +77,63 @@ export function editInitialState({ container, state, userdata, submit }) {
     const finish = (ok) => {
       if (done) return;
       done = true;
-      area.removeEventListener("input", onInput);
+      form.removeEventListener("input", check);
+      form.removeEventListener("keydown", onKey);
       form.removeEventListener("submit", onSubmit);
       dialog.removeEventListener("close", onClose);
       resolve(ok);
     };
-    area.addEventListener("input", onInput);
+    form.addEventListener("input", check);
+    form.addEventListener("keydown", onKey);
     form.addEventListener("submit", onSubmit);
     dialog.addEventListener("close", onClose);
     dialog.showModal();
-    area.focus();
   });
+}
+
+/**
+ * The set-initial-state editor.
+ * @param {object} opts {container, state, userdata, submit(userdata) -> Promise (rejects with an Error whose message is shown)}
+ * @returns {Promise<boolean>} true when the server accepted it
+ */
+export function editInitialState({ container, state, userdata, submit }) {
+  const dialog = document.getElementById("initial-dialog");
+  const area = dialog.querySelector("textarea");
+  dialog.querySelector(".dlg-what").textContent = `Start ${container} in state ${state}`;
+  area.value = JSON.stringify(userdata || {}, null, 2);
+  const read = () => {
+    const parsed = parseUserdata(area.value);
+    area.classList.toggle("invalid", Boolean(parsed.error));
+    return parsed;
+  };
+  const shown = formDialog(dialog, read, submit);
+  area.focus();
+  return shown;
+}
+
+/**
+ * The "Break when…" editor of a breakpoint on the state at `state`: before or after it, after it
+ * only with one of its `outcomes` (or any), when a condition holds (or always).
+ * @param {object} opts {state, outcomes, submit({state, at, outcome, when}) -> Promise (rejects with an Error whose message, the server's, is shown)}
+ * @returns {Promise<boolean>} true when the server accepted it
+ */
+export function editBreakpoint({ state, outcomes, submit }) {
+  const dialog = document.getElementById("break-dialog");
+  const form = dialog.querySelector("form");
+  const outcome = form.elements.outcome;
+  const when = form.elements.when;
+  dialog.querySelector(".dlg-what").textContent = state;
+  form.elements.at.value = "before";
+  outcome.replaceChildren(h("option", { value: "", text: "any" }), ...outcomes.map((o) => h("option", { value: o, text: o })));
+  when.value = "";
+  const read = () => {
+    const at = form.elements.at.value;
+    outcome.disabled = at !== "after";
+    return { value: { state, at, outcome: at === "after" && outcome.value ? outcome.value : null, when: when.value.trim() || null } };
+  };
+  const shown = formDialog(dialog, read, submit);
+  when.focus();
+  return shown;
 }
 
 /** A context menu at (x, y) with items [{label, action, disabled, title}]. */

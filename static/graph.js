@@ -161,7 +161,8 @@ export class GraphView {
 
   /**
    * @param {object} view {active: [paths], running: [container paths], reached: [o: ids],
-   *   lastEdges: [e: ids], failed: [paths], selected: path|null}
+   *   lastEdges: [e: ids], failed: [paths], selected: path|null, breakpoints: [paths with one],
+   *   held: [paths where the machine holds]}
    */
   apply(view) {
     if (!this.svg) return;
@@ -181,20 +182,22 @@ export class GraphView {
     this._setClass("active", active);
     this._setClass("reached", new Set(view.reached));
     this._setClass("last", new Set(view.lastEdges));
-    const failed = new Set();
-    for (const path of view.failed) {
-      const el = this.stateElement(path);
-      if (el) failed.add(el.id);
-    }
-    this._setClass("failed", failed);
-    const selected = new Set();
-    if (view.selected) {
-      const el = this.stateElement(view.selected);
-      if (el) selected.add(el.id);
-    }
-    this._setClass("selected", selected);
+    this._setClass("failed", this._drawnIds(view.failed));
+    this._setClass("selected", this._drawnIds(view.selected ? [view.selected] : []));
+    this._setClass("breakpoint", this._drawnIds(view.breakpoints));
+    this._setClass("held", this._drawnIds(view.held));
     this.marks.show(new Set([...this.classed.values()].flatMap((ids) => [...ids])));
     if (pan) this._setViewBox(pan);
+  }
+
+  /** The ids of the elements standing for `paths` (each itself or its closest drawn ancestor). */
+  _drawnIds(paths) {
+    const ids = new Set();
+    for (const path of paths) {
+      const el = this.stateElement(path);
+      if (el) ids.add(el.id);
+    }
+    return ids;
   }
 
   /** Pan (never zoom) so that `el` is inside the view, when it is not already. */

@@ -1,9 +1,9 @@
-// The graph's marks (active, reached, last edge, failed, selected) drawn over the drawing, so the
-// drawing itself never repaints when the instant changes. The drawing's elements keep their
-// classes (the contract of docs/api.md: `#graph g.node.active` is the drawn state), but no style
-// reads them; each marked element gets a copy in an overlay <svg> with the same viewBox, placed
-// by its ancestors' transforms, and only the copies are styled. Their classes are the element's
-// with "m-" in front, so no selector meant for the drawing ever matches a copy.
+// The graph's marks (active, reached, last edge, failed, selected, breakpoint, held) drawn over the
+// drawing, so the drawing itself never repaints when the instant changes. The drawing's elements
+// keep their classes (the contract of docs/api.md: `#graph g.node.active` is the drawn state), but
+// no style reads them; each marked element gets a copy in an overlay <svg> with the same viewBox,
+// placed by its ancestors' transforms, and only the copies are styled. Their classes are the
+// element's with "m-" in front, so no selector meant for the drawing ever matches a copy.
 //
 // Why: Chromium repaints and re-layerizes a whole SVG when any of its elements changes style; at
 // 606 states (1,400 elements) that was 15 ms of every frame (bench/timetravel_browser.py), and
@@ -35,6 +35,31 @@ function drawnParts(el, kind) {
     for (const named of [copy, ...copy.querySelectorAll("[id]")]) named.removeAttribute("id");
     return copy;
   });
+}
+
+// A state's debugger marks, also drawn as badges at its corners: a dot for a breakpoint (top left),
+// a pause sign where the machine holds (top right). Their classes show them (style.css).
+const BADGED = ["breakpoint", "held"];
+
+function svgElement(name, attributes) {
+  const el = document.createElementNS(SVG_NS, name);
+  for (const [key, value] of Object.entries(attributes)) el.setAttribute(key, value);
+  return el;
+}
+
+/** The badges of the drawing's element `el`, in its own coordinates (measured once per element). */
+function badges(el) {
+  const box = el.getBBox();
+  const r = Math.max(3, Math.min(6, box.height / 4));
+  const group = svgElement("g", { class: "badges" });
+  group.append(svgElement("circle", { class: "bp-badge", cx: box.x + r / 2, cy: box.y + r / 2, r }));
+  const held = svgElement("g", { class: "held-badge" });
+  const [x, y] = [box.x + box.width - r / 2, box.y + r / 2];
+  held.append(svgElement("circle", { cx: x, cy: y, r: r * 1.2 }),
+    svgElement("rect", { x: x - r * 0.5, y: y - r * 0.6, width: r * 0.35, height: r * 1.2 }),
+    svgElement("rect", { x: x + r * 0.15, y: y - r * 0.6, width: r * 0.35, height: r * 1.2 }));
+  group.append(held);
+  return group;
 }
 
 export class GraphMarks {
@@ -92,7 +117,11 @@ export class GraphMarks {
         this._place(kind, el.hasAttribute("transform") ? el : el.parentElement).append(copy);
         this.copies.set(id, copy);
       }
-      if (copy.getAttribute("class") !== classes) copy.setAttribute("class", classes);
+      if (copy.getAttribute("class") === classes) continue;
+      copy.setAttribute("class", classes);
+      if (!copy.lastElementChild?.classList.contains("badges") && BADGED.some((name) => el.classList.contains(name))) {
+        copy.append(badges(el));
+      }
     }
   }
 }

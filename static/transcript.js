@@ -154,7 +154,7 @@ function controlLine(ev) {
 const MODE_WORDS = { run: "running", pause: "pausing at the next transition", step: "stepping one transition" };
 
 /** A debug event's line, in the words of fsm/logfiles/transcript.py's debug_message. */
-function debugLine(ev) {
+export function debugLine(ev) {
   const by = ev.by ? ` by ${ev.by}` : "";
   switch (ev.action) {
     case "mode": {

@@ -69,14 +69,21 @@ export class TreeView {
     else this.collapsed.delete(path);
   }
 
-  /** @param {string[]} failed the failing state and the containers it brought down */
-  update(status, failed) {
+  /**
+   * @param {string[]} failed the failing state and the containers it brought down
+   * @param {{breakpoints: string[], held: string[]}} marks the states with a breakpoint, where the machine holds
+   */
+  update(status, failed, marks) {
     const active = new Set(status.activePaths());
     if (status.running && status.root_path) active.add(status.root_path);
     const failedSet = new Set(failed);
+    const breakpoints = new Set(marks.breakpoints);
+    const held = new Set(marks.held);
     for (const [path, row] of this.rows) {
       row.classList.toggle("active", active.has(path));
       row.classList.toggle("failed", failedSet.has(path));
+      row.classList.toggle("breakpoint", breakpoints.has(path));
+      row.classList.toggle("held", held.has(path));
       const entry = status.containers[path];
       const out = row.lastElementChild;
       const text = entry && !entry.running && entry.outcome ? "→ " + entry.outcome : "";

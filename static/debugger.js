@@ -1,0 +1,92 @@
+// The debugger's bar: a banner saying where and why the machine holds, in the transcript's words,
+// with Resume, Step, Step over and Force outcome; and Pause in the top bar. Like the other controls
+// (controls.js) they are hidden from a viewer; they are disabled while the page does not show the
+// live machine (looking back, a replay), when the banner shows the hold of the instant shown.
+
+import { api } from "./api.js";
+import { showMenu } from "./dialogs.js";
+import { debugLine } from "./transcript.js";
+
+const $ = (id) => document.getElementById(id);
+const BUTTONS = ["pause-btn", "resume-btn", "step-btn", "step-over-btn", "force-btn"];
+
+/** What the banner says of a debugger's state `debug` ({mode, level, holds}): each hold, or the mode
+ * when nothing holds yet; null when it runs free. */
+export function pausedText(debug) {
+  if (!debug) return null;
+  if (debug.holds.length) {
+    return "Paused " + debug.holds.map((hold) => `in ${hold.path}: ${debugLine({ action: "hold", ...hold }).text}`).join("; ");
+  }
+  return debug.mode === "run" ? null : debugLine({ action: "mode", mode: debug.mode, level: debug.level }).text;
+}
+
+export class DebugBar {
+  /**
+   * @param {Store} store the machine shown (store.js)
+   * @param {Controls} controls its controls (controls.js): the page's role, why it may not control, `ask`
+   * @param {() => boolean} live whether the page shows the live machine (its stream live, not looking back)
+   */
+  constructor(store, controls, live) {
+    this.store = store;
+    this.controls = controls;
+    this.live = live;
+    $("pause-btn").addEventListener("click", () => controls.ask("Pause", api.pause));
+    $("resume-btn").addEventListener("click", () => controls.ask("Resume", api.resume));
+    $("step-btn").addEventListener("click", () => controls.ask("Step", api.step));
+    $("step-over-btn").addEventListener("click", () => {
+      const level = this._holds()[0]?.path;
+      if (level) controls.ask("Step over", (name) => api.step(name, level));
+    });
+    $("force-btn").addEventListener("click", (e) => {
+      const box = e.currentTarget.getBoundingClientRect();
+      showMenu(box.left, box.bottom + 2, "Force an outcome", this._forceItems());
+    });
+  }
+
+  /** Show the debugger's state of `shown` (the status of the instant shown; null: no machine) and
+   * enable what the live machine accepts now. */
+  update(shown) {
+    const text = pausedText(shown?.debug);
+    const bar = $("debug-bar");
+    bar.hidden = text === null;
+    const what = bar.querySelector(".debug-text");
+    if (text !== null && what.textContent !== text) what.textContent = text;
+    const now = this.store.status?.debug ?? { mode: "run", holds: [] };
+    const paused = now.mode !== "run" || now.holds.length > 0;
+    const can = this.live() && !this.controls.refusal();
+    const enabled = {
+      "pause-btn": !paused && Boolean(this.store.status?.running),
+      "resume-btn": paused,
+      "step-btn": paused,
+      "step-over-btn": now.holds.length > 0,
+      "force-btn": this._forceTargets().length > 0,
+    };
+    for (const id of BUTTONS) {
+      $(id).hidden = this.controls.viewer;
+      $(id).disabled = !can || !enabled[id];
+    }
+  }
+
+  _holds() {
+    return this.store.status?.debug?.holds ?? [];
+  }
+
+  /** The states whose outcome may be forced: the held ones, or, when none holds, the active leaves. */
+  _forceTargets() {
+    const status = this.store.status;
+    if (!status?.running) return [];
+    const held = this._holds().map((hold) => hold.path + "/" + hold.state);
+    return (held.length ? held : status.activeLeaves()).filter((path) => this.store.nodes.get(path)?.outcomes.length);
+  }
+
+  /** An item per registered outcome of each of those states. */
+  _forceItems() {
+    return this._forceTargets().flatMap((path) => {
+      const node = this.store.nodes.get(path);
+      return node.outcomes.map((outcome) => ({
+        label: `${node.label} → ${outcome}`, title: path,
+        action: () => this.controls.ask(`Force '${outcome}' of ${path}`, (name) => api.force(name, path, outcome)),
+      }));
+    });
+  }
+}

@@ -45,6 +45,15 @@ async function request(method, url, body, accept = "json") {
 
 const machine = (name) => "/api/machines/" + encodeURIComponent(name);
 
+const controlListeners = new Set();
+
+/** A control of machine `name` (one the lease covers): the listeners hear of each one accepted. */
+async function control(method, name, path, body) {
+  const answer = await request(method, machine(name) + path, body);
+  for (const listener of controlListeners) listener(name);
+  return answer;
+}
+
 /** `?a=1&b=2&b=3` of the defined entries of `params`, an array giving a key once per item ("" when none). */
 function query(params) {
   const qs = new URLSearchParams();
@@ -71,17 +80,18 @@ export const api = {
   scenePose: (pose) => request("POST", "/api/scene/pose", { pose }),
   graphSvg: (name, expand) => request("GET", machine(name) + "/graph.svg" + query({ expand }), undefined, "text"),
   preempt: (name, reason) => request("POST", machine(name) + "/preempt", { reason: reason || "" }),
-  setInitialState: (name, path, states, userdata) =>
-    request("POST", machine(name) + "/initial-state", { path, states, userdata }),
-  start: (name) => request("POST", machine(name) + "/start", {}),
+  setInitialState: (name, path, states, userdata) => control("POST", name, "/initial-state", { path, states, userdata }),
+  start: (name) => control("POST", name, "/start", {}),
   hold: (name, reason) => request("POST", machine(name) + "/hold", { reason: reason || "" }),
-  pause: (name) => request("POST", machine(name) + "/pause"),
-  resume: (name) => request("POST", machine(name) + "/resume"),
+  pause: (name) => control("POST", name, "/pause"),
+  resume: (name) => control("POST", name, "/resume"),
   /** One transition, then hold again; `level` a container's path: at its next transition (a step over). */
-  step: (name, level = null) => request("POST", machine(name) + "/step", { level }),
-  force: (name, state, outcome) => request("POST", machine(name) + "/force", { state, outcome }),
+  step: (name, level = null) => control("POST", name, "/step", { level }),
+  force: (name, state, outcome) => control("POST", name, "/force", { state, outcome }),
   /** Replace the machine's whole set of breakpoints (docs/debugging.md). */
-  setBreakpoints: (name, breakpoints) => request("PUT", machine(name) + "/breakpoints", { breakpoints }),
+  setBreakpoints: (name, breakpoints) => control("PUT", name, "/breakpoints", { breakpoints }),
+  /** Call `listener(name)` after each accepted control that the lease covers (a page's first one takes it). */
+  onControl: (listener) => controlListeners.add(listener),
   /** Who controls the machine (docs/debugging.md): {holder, yours, deadman, beat_every}. */
   lease: (name) => request("GET", machine(name) + "/lease"),
   takeLease: (name, takeover) => request("POST", machine(name) + "/lease", { takeover }),

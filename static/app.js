@@ -4,6 +4,7 @@
 // purpose: it is the one place where the page's parts meet, and it holds no logic of its own.
 
 import { api } from "./api.js";
+import { Audit } from "./audit.js";
 import { showBadge } from "./badge.js";
 import { Breakpoints, debugMarks } from "./breakpoints.js";
 import { readLink, writeLink } from "./deeplink.js";
@@ -12,6 +13,7 @@ import { DebugBar } from "./debugger.js";
 import { Depth } from "./depth.js";
 import { showMenu } from "./dialogs.js";
 import { GraphView } from "./graph.js";
+import { Lease } from "./lease.js";
 import { Machines, isReplay, showRunState } from "./machines.js";
 import { RunNotices, notice } from "./notice.js";
 import { EventLog } from "./eventlog.js";
@@ -90,6 +92,9 @@ const machines = new Machines($("machine-picker"), store, {
 });
 const controls = new Controls(store, machines, notices, () => stream?.state === "live");
 api.session().then((s) => controls.setRole(s.role)).catch(() => {}); // no valid token: token.js says so
+const lease = new Lease(store, controls);
+const audit = new Audit(store);
+$("audit-btn").addEventListener("click", () => audit.open());
 const showsLive = () => stream?.state === "live" && !playhead.past; // the debugger controls only what it shows
 const breakpoints = new Breakpoints(store, controls, showsLive);
 const debugBar = new DebugBar(store, controls, showsLive);
@@ -234,6 +239,7 @@ function stateMenu(path, x, y) {
 
 function updateTopBar() {
   controls.update();
+  lease.update();
   debugBar.update(shownStatus());
   showRunState($("run-state"), shownStatus(), machines.current());
 }

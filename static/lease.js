@@ -23,6 +23,9 @@ export class Lease {
     this.timer = null;
     this.heart = null; // the heartbeat worker (heartbeat.js), made when this page first holds a lease
     this.beating = null; // the machine it beats for
+    api.onControl((name) => { // a page's first control takes a free lease: ask at once, to start beating
+      if (name === this.name && !this.state?.yours) this._schedule(0);
+    });
     $("lease-take").addEventListener("click", () => this._take());
     $("lease-release").addEventListener("click", () => this._release());
   }

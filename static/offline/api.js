@@ -31,6 +31,7 @@ export const api = {
   step: refuse,
   force: refuse,
   setBreakpoints: refuse,
+  onControl: () => {},
   lease: refuse,
   takeLease: refuse,
   beatRequest: () => null,

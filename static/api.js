@@ -92,12 +92,10 @@ export const api = {
   setBreakpoints: (name, breakpoints) => control("PUT", name, "/breakpoints", { breakpoints }),
   /** Call `listener(name)` after each accepted control that the lease covers (a page's first one takes it). */
   onControl: (listener) => controlListeners.add(listener),
-  /** Who controls the machine (docs/debugging.md): {holder, yours, deadman, beat_every}. */
-  lease: (name) => request("GET", machine(name) + "/lease"),
   takeLease: (name, takeover) => request("POST", machine(name) + "/lease", { takeover }),
-  /** The lease holder's heartbeat, as heartbeat.js sends it: {url, headers} of a POST answered as lease()
-   * is, or 409 when this page lost the lease. */
-  beatRequest: (name) => ({ url: machine(name) + "/lease/beat", headers: pageHeaders() }),
+  /** What heartbeat.js asks, off the main thread: `lease` (GET, as lease()) and `beat` (POST: the
+   * holder's heartbeat, answered as lease() is, or 409 when this page lost the lease), with `headers`. */
+  leaseWatch: (name) => ({ lease: machine(name) + "/lease", beat: machine(name) + "/lease/beat", headers: pageHeaders() }),
   releaseLease: (name) => request("DELETE", machine(name) + "/lease"),
   streamUrl(name, since) {
     const proto = location.protocol === "https:" ? "wss:" : "ws:";

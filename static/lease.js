@@ -1,6 +1,7 @@
 // Who controls the machine shown (docs/debugging.md, "One operator at a time"): the operator lease.
-// While the page holds the lease a worker (heartbeat.js) sends its heartbeat, so a page that is
-// closed or cut off stops beating and the server's deadman acts; otherwise the page asks who holds it. The pill says
+// A worker (heartbeat.js) asks who holds it every second, off the main thread, and sends the
+// heartbeat while this page holds it, so a page that is closed or cut off stops beating and the
+// server's deadman acts, and a busy one does not. The pill says
 // who holds control; "Take control" takes a free lease or, confirmed, another page's.
 
 import { api } from "./api.js";
@@ -8,7 +9,7 @@ import { clockText } from "./clocktext.js";
 import { notice } from "./notice.js";
 
 const $ = (id) => document.getElementById(id);
-const POLL_MS = 2000; // how often a page that does not hold the lease asks who does
+const BEAT_MS = 1000; // how often the worker asks (server/lease.py BEAT_EVERY: the heartbeat's period)
 
 export class Lease {
   /**
@@ -19,71 +20,40 @@ export class Lease {
     this.store = store;
     this.controls = controls;
     this.state = null; // the last answer about the machine shown, null when unknown
-    this.name = null; // the machine that answer is of
-    this.timer = null;
-    this.heart = null; // the heartbeat worker (heartbeat.js), made when this page first holds a lease
-    this.beating = null; // the machine it beats for
+    this.name = null; // the machine shown
+    this.watching = null; // the machine the worker watches (null: none)
+    this.heart = null; // the worker (heartbeat.js), made when the page first watches a machine
     api.onControl((name) => { // a page's first control takes a free lease: ask at once, to start beating
-      if (name === this.name && !this.state?.yours) this._schedule(0);
+      if (name === this.watching) this.heart.postMessage({ now: true });
     });
     $("lease-take").addEventListener("click", () => this._take());
     $("lease-release").addEventListener("click", () => this._release());
   }
 
-  /** Follow the machine shown (call when it changes and on every controls update). */
+  /** Follow the machine shown and whether this page may control it (call on every controls update). */
   update() {
-    if (this.store.name !== this.name) {
-      this.name = this.store.name;
-      this._answered(null);
-      this._schedule(0);
-    }
-    this._show();
-  }
-
-  _schedule(ms) {
-    clearTimeout(this.timer);
-    this.timer = setTimeout(() => this._poll(), ms);
-  }
-
-  /** Ask who holds the lease (the heartbeat's answers say it while this page holds it). */
-  async _poll() {
-    const name = this.name;
-    if (name && !this.controls.refusal() && !this.state?.yours) {
-      try {
-        const state = await api.lease(name);
-        if (name === this.name) this._answered(state);
-      } catch (err) {
-        if (name === this.name) this._answered(null);
-      }
-    }
-    this._schedule(POLL_MS);
-  }
-
-  /** A new answer about the machine shown: show it, and beat while it says this page holds the lease. */
-  _answered(state) {
-    this.state = state;
-    const beatFor = state?.yours ? this.name : null;
-    if (beatFor !== this.beating) {
-      this.beating = beatFor;
-      if (beatFor && !this.heart) {
+    this.name = this.store.name;
+    const want = this.name && !this.controls.refusal() ? this.name : null;
+    if (want !== this.watching) {
+      this.watching = want;
+      this.state = null;
+      if (want && !this.heart) {
         this.heart = new Worker(new URL("./heartbeat.js", import.meta.url));
-        this.heart.onmessage = (message) => this._beaten(message.data);
+        this.heart.onmessage = (message) => this._answered(message.data);
       }
-      const request = beatFor ? api.beatRequest(beatFor) : null;
-      this.heart?.postMessage(request ? { ...request, every: state.beat_every * 1000 } : { url: null });
+      this.heart?.postMessage(want ? { ...api.leaseWatch(want), every: BEAT_MS } : { lease: null });
     }
     this._show();
   }
 
-  /** The heartbeat's answer: the lease as before, or lost (another page took it over, or it lapsed). */
-  _beaten({ status, body }) {
-    const name = this.beating;
-    if (name !== this.name) return;
-    if (status === 200) this._answered(body);
-    else if (status === 409) {
-      notice(`You no longer control ${name}: ${body?.detail ?? "the lease is gone"}`, "warn", true);
-      this._answered(null);
+  /** The worker's answer: who holds the lease, or that this page lost it (taken over, or lapsed). */
+  _answered({ status, body, beat }) {
+    if (status === 200) this.state = body;
+    else if (status === 409 && beat) {
+      notice(`You no longer control ${this.watching}: ${body?.detail ?? "the lease is gone"}`, "warn", true);
+      this.state = null;
     }
+    this._show();
   }
 
   async _take() {
@@ -92,21 +62,25 @@ export class Lease {
     const takeover = Boolean(holder) && !this.state.yours;
     if (takeover && !window.confirm(`${holder.client} controls ${name}. Take control over? That page loses it.`)) return;
     try {
-      this._answered(await api.takeLease(name, takeover));
+      this.state = await api.takeLease(name, takeover);
+      this.heart.postMessage({ now: true, yours: true }); // beat from now on
       notice(`You control ${name}`, "ok");
     } catch (err) {
       notice("Could not take control: " + (err.detail || err.message), "error", true);
     }
+    this._show();
   }
 
   async _release() {
     const name = this.name;
     try {
-      this._answered(await api.releaseLease(name));
+      this.state = await api.releaseLease(name);
+      this.heart.postMessage({ now: true, yours: false });
       notice(`You gave up control of ${name}`, "ok");
     } catch (err) {
       notice("Could not give up control: " + (err.detail || err.message), "error", true);
     }
+    this._show();
   }
 
   /** The pill and the two buttons, from the last answer. */

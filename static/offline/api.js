@@ -32,9 +32,8 @@ export const api = {
   force: refuse,
   setBreakpoints: refuse,
   onControl: () => {},
-  lease: refuse,
   takeLease: refuse,
-  beatRequest: () => null,
+  leaseWatch: () => null,
   releaseLease: refuse,
   streamUrl: () => "",
 };

@@ -1,0 +1,155 @@
+"""Big machines in the page (issue 11), measured in real Chromium (Debian's); a table against the targets:
+
+- follow: a 600-state machine (server/testing/big_machine.py: 40 containers, 560 leaves, Concurrences)
+  drawn fully open, running at ~1,000 events/s, the page following the active state: the share of
+  the time the page's main thread spends in long tasks (PerformanceObserver "longtask": tasks over
+  50 ms) <= 20 %, and the longest gap between two frames (requestAnimationFrame) <= 100 ms; medians
+  of the rounds, each round a fresh page watching for ``--seconds``;
+- first graph: a 2,000-state machine (85 containers, 1,955 leaves), idle: from the navigation's
+  start to the graph's SVG in the page <= 1 s, median of the rounds (a fresh page each).
+
+The machines run in this process, served by a real uvicorn on a free port (server.http_server), as a
+user's ``IntrospectionServer`` would. Run it under the browser lock:
+
+    flock /tmp/fsmscope-browser.lock .venv/bin/python bench/big_machine_browser.py [--rounds 3] [--seconds 5]
+"""
+
+import argparse
+import os
+import statistics
+import sys
+import threading
+import time
+
+# The repository first: run as a script, this folder comes first and its server.py would shadow the package.
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, ROOT)
+
+import fsm  # noqa: E402
+from server.http_server import ServerThread  # noqa: E402
+from server.testing.big_machine import big_machine, count_states  # noqa: E402
+from server.testing.browser import launch_chromium, open_page  # noqa: E402
+from table import print_table, verdict  # noqa: E402
+
+RATE = 1000  # events/s the running machine is paced to
+FOLLOW_SHAPE = (3, 4, 14)  # branching, depth, leaves: 600 states
+FIRST_SHAPE = (4, 4, 23)  # 2,040 states
+
+# Installed before the page's scripts: long tasks, frame gaps, and when the graph's SVG appeared.
+PROBE = """(() => {
+  const probe = window.__probe = { long: [], gaps: [], svgAt: null, watching: false, last: null };
+  new PerformanceObserver((list) => {
+    for (const e of list.getEntries()) if (probe.watching) probe.long.push(e.duration);
+  }).observe({ type: "longtask" });
+  const frame = (now) => {
+    if (probe.watching && probe.last !== null) probe.gaps.push(now - probe.last);
+    probe.last = now;
+    requestAnimationFrame(frame);
+  };
+  requestAnimationFrame(frame);
+  new MutationObserver(() => {
+    if (probe.svgAt === null && document.querySelector("#graph svg")) probe.svgAt = performance.now();
+  }).observe(document, { childList: true, subtree: true });
+})()"""
+
+
+def events_per_second(shape: tuple[int, int, int], tick: float, seconds: float = 1.0) -> float:
+    """How many events a second the machine of ``shape`` emits with ``tick``, run alone for ``seconds``."""
+    sm, stop = big_machine(*shape, tick=tick)
+    times = []
+    fsm.attach(sm, lambda e: times.append(e["t"]), name="calibration")
+    runner = threading.Thread(target=sm.execute)
+    runner.start()
+    time.sleep(seconds)
+    stop.set()
+    runner.join()
+    return len(times) / (times[-1] - times[0])
+
+
+def paced_tick(shape: tuple[int, int, int]) -> float:
+    """The tick (seconds a leaf waits) that makes the machine of ``shape`` emit about RATE events/s."""
+    tick = 2.0 / RATE  # a leaf's step is about two events: its transition and its userdata change
+    return tick * events_per_second(shape, tick) / RATE
+
+
+def follow_round(browser, srv: ServerThread, seconds: float) -> tuple[float, float, float]:
+    """(long-task share %, longest frame gap ms, events/s the page saw) of one fresh page, all open."""
+    page = open_page(browser, srv.url + "#m=big", 1600, 900, timeout_ms=30000)
+    try:
+        page.add_init_script(PROBE)
+        page.reload()
+        page.wait_for_selector("#badge.live")
+        page.wait_for_selector("#graph svg")
+        deepest = page.evaluate("() => [...document.querySelectorAll('#depth option:not([hidden])')]"
+                                ".map(o => o.value).filter(v => /^\\d+$/.test(v)).pop()")
+        page.select_option("#depth", deepest)
+        page.wait_for_function("() => document.querySelectorAll('#graph g.node').length >= 560", timeout=30000)
+        page.check("#follow")
+        page.wait_for_timeout(1000)
+        seq0 = page.evaluate("window.fsmscope.liveStatus.last_seq")
+        page.evaluate("() => { const p = window.__probe; p.long = []; p.gaps = []; p.last = null; p.watching = true; }")
+        started = time.monotonic()
+        page.wait_for_timeout(seconds * 1000)
+        probe = page.evaluate("() => { const p = window.__probe; p.watching = false; return p; }")
+        elapsed = time.monotonic() - started
+        seen = (page.evaluate("window.fsmscope.liveStatus.last_seq") - seq0) / elapsed
+        share = 100.0 * sum(probe["long"]) / (elapsed * 1000)
+        return share, max(probe["gaps"] or [0.0]), seen
+    finally:
+        page.close()
+
+
+def first_graph_round(browser, srv: ServerThread) -> float:
+    """Milliseconds from a fresh page's navigation to the graph's SVG in it."""
+    context = browser.new_context(viewport={"width": 1600, "height": 900})
+    try:
+        page = context.new_page()
+        page.add_init_script(PROBE)
+        page.goto(srv.url + "#m=big2")
+        page.wait_for_function("() => window.__probe.svgAt !== null", timeout=30000)
+        return page.evaluate("window.__probe.svgAt")
+    finally:
+        context.close()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--rounds", type=int, default=3)
+    parser.add_argument("--seconds", type=float, default=5.0)
+    args = parser.parse_args()
+    fsm.set_loggers(*[lambda msg: None] * 4)
+    from playwright.sync_api import sync_playwright
+
+    srv = ServerThread().start()
+    sm, stop = big_machine(*FOLLOW_SHAPE, tick=paced_tick(FOLLOW_SHAPE))
+    srv.hub.add_local(sm, name="big")
+    runner = threading.Thread(target=sm.execute, daemon=True)
+    runner.start()
+    idle, _ = big_machine(*FIRST_SHAPE)
+    srv.hub.add_local(idle, name="big2")
+    try:
+        with sync_playwright() as pw:
+            browser = launch_chromium(pw)
+            follows = [follow_round(browser, srv, args.seconds) for _ in range(args.rounds)]
+            firsts = [first_graph_round(browser, srv) for _ in range(args.rounds)]
+            browser.close()
+    finally:
+        stop.set()
+        runner.join(10)
+        srv.stop()
+    share = statistics.median(f[0] for f in follows)
+    gap = statistics.median(f[1] for f in follows)
+    rate = statistics.median(f[2] for f in follows)
+    first = statistics.median(firsts)
+    print_table("Big machines in the page, real Chromium (medians of %d rounds)" % args.rounds, [
+        ("follow, %d states all open: events/s the page saw" % count_states(*FOLLOW_SHAPE), "~%d" % RATE,
+         "%.0f" % rate, verdict(None)),
+        ("follow: main thread in long tasks", "<= 20 %", "%.1f %%" % share, verdict(share <= 20)),
+        ("follow: longest frame gap", "<= 100 ms", "%.0f ms" % gap, verdict(gap <= 100)),
+        ("first graph, %d states: navigation to SVG" % count_states(*FIRST_SHAPE), "<= 1000 ms", "%.0f ms" % first,
+         verdict(first <= 1000)),
+    ])
+
+
+if __name__ == "__main__":
+    main()

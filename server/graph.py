@@ -17,6 +17,7 @@ from __future__ import annotations
 import collections
 import concurrent.futures
 import os
+import re
 import shutil
 import subprocess
 import threading
@@ -34,6 +35,8 @@ ET.register_namespace("", SVG_NS)
 ET.register_namespace("xlink", XLINK_NS)
 _G = "{%s}g" % SVG_NS
 _POLYGON = "{%s}polygon" % SVG_NS
+_TITLE = "{%s}title" % SVG_NS
+_PAGE = re.compile(r"^page\d+,\d+_(?=[scoe]:)")  # dot's prefix of ids when it paginates (static/graph.js drops it too)
 
 AUTO_OPEN_LIMIT = 150   # without ``expand``: every container open up to this many states, else only the root
 DOT_TIMEOUT = 60.0
@@ -66,9 +69,21 @@ def open_set(root: dict, expand: Iterable[str] | None, n_states: int) -> frozens
     return frozenset(c["path"] for c in reached if c["path"] in wanted)
 
 
-def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
-    """One container's graph; ``sizes`` gives the drawing size (points) of each open child container."""
+def _visible(text: str) -> str:
+    """Text XML can hold: each control character as its control picture (as labels show it)."""
+    return str(text).translate(_VISIBLE)
+
+
+def described(node: dict) -> str:
+    """What a state's or container's title (its tooltip) says: its path and class, never a Graphviz name."""
+    return _visible("%s (%s)" % (node["path"], node.get("type", "")))
+
+
+def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.Dot, dict[str, str]]:
+    """One container's graph, and the title of each element by id (dot would title them by its own
+    node names, "n12"); ``sizes`` gives the drawing size (points) of each open child container."""
     path = node["path"]
+    titles = {container_id(path): described(node)}
     g = pydot.Dot(q(path), graph_type="digraph")
     g.set("id", q(container_id(path)))
     g.set("label", q(node["label"] + " (" + node.get("type", "") + ")"))
@@ -86,6 +101,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
         name = "n%d" % i
         names[child["label"]] = name
         cpath = child["path"]
+        titles[state_id(cpath)] = described(child)
         if cpath in sizes:
             w, h = sizes[cpath]
             g.add_node(pydot.Node(name, id=q(state_id(cpath)), label=q(""), shape="box", style="solid", color="transparent",
@@ -101,6 +117,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
         name = outcome_nodes.get(outcome)
         if name is None:
             name = outcome_nodes[outcome] = "o%d" % len(outcome_nodes)
+            titles[outcome_id(path, outcome)] = _visible("%s: outcome %s" % (path, outcome))
             g.add_node(pydot.Node(name, id=q(outcome_id(path, outcome)), label=q(outcome), shape="ellipse",
                                   style="filled", fillcolor="lightgrey", **{"class": q("outcome")}))
         return name
@@ -125,6 +142,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
         seen[eid] = n + 1
         if n:
             eid += ":%d" % (n + 1)
+        titles[eid] = _visible("%s: %s --%s--> %s" % (path, tr["from"], tr["outcome"], target))
         attrs = {"id": q(eid), ("xlabel" if big else "label"): q(tr["outcome"])}
         if dst in outcome_set:  # edges into outcomes do not rank: many long edges to one sink explode dot
             attrs["constraint"] = "false"
@@ -134,7 +152,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> pydot.Dot:
         for name in outcome_nodes.values():
             sink.add_node(pydot.Node(name))
         g.add_subgraph(sink)
-    return g
+    return g, titles
 
 
 def run_dot(graphs: list[pydot.Dot]) -> list[ET.Element]:
@@ -235,14 +253,14 @@ class Renderer:
                     todo.append((node, pkey))
             if not todo:
                 continue
-            graphs = []
+            built = []
             for node, _ in todo:
                 sizes = {c["path"]: done[c["path"]][1:] for c in node.get("children") or () if c["path"] in done}
-                graphs.append(build_dot(node, sizes))
-            svgs = run_dot_parallel(graphs)
+                built.append(build_dot(node, sizes))
+            svgs = run_dot_parallel([g for g, _ in built])
             self.layouts += len(todo)
-            for (node, pkey), svg in zip(todo, svgs):
-                part = self._compose(node, svg, done)
+            for (node, pkey), svg, (_, titles) in zip(todo, svgs, built):
+                part = self._compose(node, svg, done, titles)
                 done[node["path"]] = part
                 self._parts[pkey] = part
             while len(self._parts) > self._max_parts:
@@ -254,11 +272,17 @@ class Renderer:
         return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(svg)
 
     @staticmethod
-    def _compose(node: dict, svg: ET.Element, done: dict) -> tuple[ET.Element, float, float]:
-        """The container's drawing with each open child's drawing put in its placeholder's place."""
+    def _compose(node: dict, svg: ET.Element, done: dict, titles: dict[str, str]) -> tuple[ET.Element, float, float]:
+        """The container's drawing, its elements titled by ``titles``, with each open child's drawing put
+        in its placeholder's place."""
         group = svg.find(_G)
         if group is None:
             raise GraphError("dot produced no graph for %s" % node["path"])
+        for g in (group, *group.iter(_G)):
+            title = g.find(_TITLE)
+            eid = _PAGE.sub("", g.get("id", ""))
+            if title is not None and eid in titles:
+                title.text = titles[eid]
         group.set("class", "cluster")
         frame = group.find(_POLYGON)
         if frame is not None:

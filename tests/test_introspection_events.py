@@ -126,7 +126,7 @@ def test_structure_describes_the_tree_with_paths_sorted_lists_and_transitions(ob
         "outcomes": ["done"], "initial": ["FOO"]}
     foo, sub = root["children"]
     assert foo == {"label": "FOO", "path": "/SM_ROOT/FOO", "type": "Out", "container": False, "outcomes": ["go"],
-                   "input_keys": [], "output_keys": ["x"], "remapping": {}}
+                   "input_keys": [], "output_keys": ["x"], "remapping": {}, "doc": Out.__doc__}
     assert (sub["path"], sub["children"][0]["path"]) == ("/SM_ROOT/SUB", "/SM_ROOT/SUB/LEAF")
     assert root["transitions"] == [{"from": "FOO", "outcome": "go", "to": "SUB"},
                                    {"from": "SUB", "outcome": "ok", "to": "done"}]

@@ -6,6 +6,8 @@ A machine nobody observes pays one ``is None`` test per step: containers check t
 
 from __future__ import annotations
 
+import functools
+import inspect
 import sys
 import threading
 import traceback
@@ -16,7 +18,7 @@ from typing import Any, Callable
 
 from ..core import log
 from .encoding import encode_userdata
-from .schema import event as _event
+from .schema import MAX_DOC, event as _event
 from .structure import children, is_container
 
 DEFAULT_ROOT_PATH = "/SM_ROOT"
@@ -105,6 +107,20 @@ class Reporter:
         return _describe(self.root, label, self.root_path, self, {})
 
 
+@functools.lru_cache(maxsize=1024)
+def class_doc(cls: type) -> str | None:
+    """The first paragraph of a class's own docstring, on one line, at most MAX_DOC characters: what a
+    user's state does, for the page's details. None for fsm's own classes (the same text in every
+    node would say nothing of the task) and a class without one (a docstring is never inherited)."""
+    doc = cls.__dict__.get("__doc__")
+    if not isinstance(doc, str) or cls.__module__.split(".")[0] == "fsm":
+        return None
+    first = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split())
+    if not first:
+        return None
+    return first if len(first) <= MAX_DOC else first[:MAX_DOC - 1] + "…"
+
+
 def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict) -> dict:
     state._reporter = rep
     state._path = path
@@ -114,6 +130,9 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
             "input_keys": sorted(map(str, state.get_registered_input_keys())),
             "output_keys": sorted(map(str, state.get_registered_output_keys())),
             "remapping": {str(k): str(v) for k, v in (remapping or {}).items()}}
+    doc = class_doc(type(state))
+    if doc is not None:
+        node["doc"] = doc
     if not node["container"]:
         return node
     if state.userdata._dirty is None:

@@ -29,6 +29,7 @@ MAX_NAME = 200                 # a machine's name
 MAX_PATH = 4096                # a container or state path
 MAX_STRUCTURE_DEPTH = 64       # container levels; JSON encoders refuse much deeper nesting
 MAX_STRUCTURE_NODES = 200_000
+MAX_DOC = 500                  # characters of a structure node's class docstring
 MAX_VALUE_DEPTH = 32           # nesting of a JSON value (userdata is cut at 16 levels when encoded)
 
 # Where a served machine's events come from (whether it takes controls is /api/machines' `controllable`).
@@ -220,6 +221,8 @@ NODE_FIELDS = (
     Field("outcomes", LIST_STR, doc="registered outcomes, sorted"),
     Field("input_keys", LIST_STR, doc="sorted"), Field("output_keys", LIST_STR, doc="sorted"),
     Field("remapping", MAP_STR, doc="its parent's remapping for it: {its key: the parent's key}"),
+    Field("doc", STR, required=False, doc="the first paragraph of its class's docstring (at most %d characters); "
+                                          "absent when the class has none or is one of fsm's own" % MAX_DOC),
 )
 CONTAINER_FIELDS = (
     Field("initial", LIST_STR, doc="initial states"), Field("transitions", _list_of(Type("a transition", lambda t: _fields_problem(

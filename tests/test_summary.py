@@ -45,10 +45,15 @@ def test_foo_bar_counts_visits_and_transitions(tmp_path):
         ("FOO", "outcome1", "BAR"): 3, ("BAR", "outcome1", "FOO"): 3, ("FOO", "outcome2", "end"): 1}
 
 
-def test_time_in_state_has_total_median_and_max():
+def test_time_in_state_has_total_median_max_and_last():
     states = summarize(_timed_run()).to_dict()["machines"]["m"]["states"]
-    assert states["/SM_ROOT/A"] == {"visits": 2, "time": {"total": 4.0, "median": 2.0, "max": 3.0}}
-    assert states["/SM_ROOT/B"] == {"visits": 2, "time": {"total": 2.5, "median": 1.25, "max": 2.0}}
+    assert states["/SM_ROOT/A"]["time"] == {"total": 4.0, "median": 2.0, "max": 3.0, "last": 3.0}
+    assert states["/SM_ROOT/B"]["time"] == {"total": 2.5, "median": 1.25, "max": 2.0, "last": 0.5}
+
+
+def test_a_state_s_last_outcome_is_the_one_it_returned_last():
+    states = summarize(_timed_run()).to_dict()["machines"]["m"]["states"]
+    assert (states["/SM_ROOT/A"]["last_outcome"], states["/SM_ROOT/B"]["last_outcome"]) == ("go", "done")
 
 
 def test_a_finished_run_exits_0():

@@ -12,6 +12,7 @@ still open when the log ends, to its last event); the idle time between runs is 
 from __future__ import annotations
 
 import statistics
+from array import array
 from typing import Any, Iterable
 
 from .structure_index import StructureIndex
@@ -33,7 +34,8 @@ class _Machine:
         self.status = INCOMPLETE
         self.ended_with_error: str | None = None
         self.visits: dict[str, int] = {}
-        self.durations: dict[str, list[float]] = {}
+        self.durations: dict[str, array] = {}  # seconds of each visit that ended (an array: a long run has millions)
+        self.last_outcome: dict[str, str] = {}  # state path -> the outcome it last returned
         self.entered: dict[str, dict[str, float | None]] = {}  # container path -> {label: entered at}
         self.transitions: dict[tuple[str, str, str, str | None], int] = {}
         self.errors: list[dict] = []
@@ -74,11 +76,25 @@ class _Machine:
     def leave(self, path: str, label: str, t: float | None) -> None:
         started = self.entered.get(path, {}).pop(label, None)
         if started is not None and t is not None:
-            self.durations.setdefault(path + "/" + label, []).append(max(0.0, t - started))
+            self.durations.setdefault(path + "/" + label, array("d")).append(max(0.0, t - started))
 
     def leave_all(self, path: str, t: float | None) -> None:
         for label in list(self.entered.get(path, {})):
             self.leave(path, label, t)
+
+    def took(self, path: str, frm: str, outcome: str, to: str | None) -> None:
+        """State ``frm`` of container ``path`` returned ``outcome``, leading to ``to``."""
+        key = (path, frm, outcome, to)
+        self.transitions[key] = self.transitions.get(key, 0) + 1
+        self.last_outcome[path + "/" + frm] = outcome
+
+    def state(self, state: str) -> dict:
+        """The statistics of one state path: visits, seconds (total, median, max, last), last outcome."""
+        times = self.durations.get(state, ())
+        return {"visits": self.visits.get(state, 0), "time": {
+            "total": sum(times), "median": statistics.median(times) if times else None,
+            "max": max(times) if times else None, "last": times[-1] if times else None},
+            "last_outcome": self.last_outcome.get(state)}
 
     def sync(self, path: str, active: list[str], t: float | None) -> None:
         current = self.entered.get(path, {})
@@ -129,8 +145,7 @@ class Summary:
             m.sync(path, list(event.get("active") or []), t)
         elif kind == "transition":
             frm = event.get("from")
-            key = (path, str(frm), str(event.get("outcome")), event.get("to"))
-            m.transitions[key] = m.transitions.get(key, 0) + 1
+            m.took(path, str(frm), str(event.get("outcome")), event.get("to"))
             if frm is not None:
                 m.leave(path, frm, t)
             m.sync(path, list(event.get("active") or []), t)
@@ -139,8 +154,7 @@ class Summary:
             outcome = event.get("outcome")
             last = event.get("last") or []
             if outcome is not None and self.structures.container_type(event) != "Concurrence" and last:
-                key = (path, str(last[0]), str(event.get("state_outcome", outcome)), str(outcome))
-                m.transitions[key] = m.transitions.get(key, 0) + 1
+                m.took(path, str(last[0]), str(event.get("state_outcome", outcome)), str(outcome))
             if path == m.root_path:
                 m.end_run(t)
                 m.outcome = outcome
@@ -175,12 +189,7 @@ class Summary:
     def to_dict(self) -> dict:
         machines = {}
         for name, m in self.machines.items():
-            states = {}
-            for state, visits in m.visits.items():
-                times = m.durations.get(state, [])
-                states[state] = {"visits": visits, "time": {
-                    "total": sum(times), "median": statistics.median(times) if times else None,
-                    "max": max(times) if times else None}}
+            states = {state: m.state(state) for state in m.visits}
             machines[name] = {
                 "status": m.status, "outcome": m.outcome, "error": m.ended_with_error, "runs": m.runs,
                 "events": m.events, "started": m.first_t, "ended": m.last_t,

@@ -218,6 +218,11 @@ class HistoryView:
             events.reverse()
         return Page(events, first, last, more, following)
 
+    def events(self, since: int, until: int) -> Iterator[dict]:
+        """The events with ``since`` <= seq <= ``until`` (within the span), oldest first, decoded."""
+        for _, raw, event in self._events(since, until, False):
+            yield event if event is not None else loads(raw)
+
     def _events(self, since: int, until: int, descending: bool) -> Iterator[Found]:
         """Events in [since, until] in the order asked: memory for what it covers, the log before that."""
         recent, log = self.recent, self.log

@@ -22,6 +22,7 @@ from fsm.observation.status import Status
 from .local_control import MachineHandle
 from .fanout import Fanout, Feed, Observer
 from .history import History, LogHistory
+from .state_stats import StateStats
 
 if TYPE_CHECKING:
     from .remote_control import RemoteHandle
@@ -46,6 +47,7 @@ class MachineEntry(Feed):
         self.reporter: introspection.Reporter | None = None
         self.observer: Observer | None = None
         self.history = History(self)  # its past (server/history.py): the ring, and a recording when it has one
+        self.stats = StateStats(name)  # its states' statistics, counted when asked (server/state_stats.py)
         self._structure_id: int | None = None
         self._structure_hash = ""
         self._n_states = 0

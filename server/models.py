@@ -89,6 +89,7 @@ class StructureNode(BaseModel):
     input_keys: list[str]
     output_keys: list[str]
     remapping: dict[str, str]
+    doc: Optional[str] = Field(None, description="the first paragraph of its class's docstring")
     initial: Optional[list[str]] = None
     children: Optional[list[StructureNode]] = None
     transitions: Optional[list[Transition]] = None
@@ -249,6 +250,39 @@ class Timeline(BaseModel):
     coarse: bool = Field(description="transitions were thinned, or the range reaches into coalesced detail")
     history_from: Optional[int] = Field(None, description="the oldest seq whose instant can be shown (GET .../status?seq="
                                         "): a machine with no recording keeps a bounded ring of recent events")
+
+
+class StateTime(BaseModel):
+    total: float = Field(description="seconds in the state over every visit that ended")
+    median: Optional[float] = Field(description="of the visits that ended (null: none has)")
+    max: Optional[float]
+    last: Optional[float] = Field(description="the last visit that ended")
+
+
+class StateStatistics(BaseModel):
+    visits: int = Field(description="times it became active")
+    time: StateTime
+    last_outcome: Optional[str] = Field(description="the outcome it returned last (null: none yet)")
+
+
+class SeqRange(BaseModel):
+    first_seq: Optional[int]
+    last_seq: Optional[int]
+
+
+class StateSummary(BaseModel):
+    """GET /api/machines/{name}/summary (docs/api.md, "State statistics")."""
+
+    model_config = ConfigDict(json_schema_extra={"examples": [{
+        "counted": {"first_seq": 1, "last_seq": 120}, "last_seq": 120, "complete": True,
+        "states": {"/SM_ROOT/PICK": {"visits": 3, "time": {"total": 1.5, "median": 0.5, "max": 0.6, "last": 0.4},
+                                     "last_outcome": "succeeded"}}}]})
+
+    counted: SeqRange = Field(description="the events counted: from the oldest the history kept when first asked")
+    last_seq: Optional[int] = Field(description="the machine's newest event")
+    complete: bool = Field(description="every event up to last_seq is counted (else ask again: at most 100,000 more "
+                                       "are read per request)")
+    states: dict[str, StateStatistics] = Field(description="by state path: the one asked, or every state visited")
 
 
 class PreemptRequest(BaseModel):

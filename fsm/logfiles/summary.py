@@ -179,6 +179,10 @@ class Summary:
         return self
 
     # Results.
+    def state(self, machine: str, state: str) -> dict:
+        """One state's statistics (``_Machine.state``); no visits and no times for one not seen."""
+        return self.machines.get(machine, _Machine(machine)).state(state)
+
     def exit_code(self) -> int:
         """0: every machine finished with an outcome; 1: one ended in an error, or never finished;
         2: not one event (the log is empty or unreadable, which is not a run that failed)."""

@@ -1,4 +1,5 @@
-"""A machine's status now or at any past event, and its events page by page (server/history.py).
+"""A machine's status now or at any past event, its events page by page (server/history.py), and the
+statistics of its states counted over them (server/state_stats.py).
 
 Both read what machine threads handed over first (``Fanout.flush``), copy what memory holds on the
 loop (``History.view``) and do the rest, file reads included, in the thread pool.
@@ -14,7 +15,8 @@ from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
 from fsm.observation.encoding import dumps
-from fsm.observation.schema import KINDS
+from fsm.observation import structure
+from fsm.observation.schema import KINDS, MAX_PATH
 
 from .. import models
 from ..history import DEFAULT_LIMIT, MAX_LIMIT, HistoryError, HistoryView
@@ -84,3 +86,16 @@ async def history(hub: HubDep, entry: Machine,
             raise HTTPException(422, "kinds: %r is not an event kind (%s)" % (unknown[0][:50], ", ".join(KINDS)))
     page = await answer(hub, entry, lambda view: view.page(since, until, limit, wanted, path, order))
     return Response(page.to_json(), media_type="application/json")
+
+
+@router.get("/api/machines/{name}/summary", response_model=models.StateSummary, responses=PAST_ERRORS)
+async def summary(hub: HubDep, entry: Machine,
+                  path: Annotated[Optional[str], Query(max_length=MAX_PATH, description="only this state or "
+                                                       "container (default: every state visited)")] = None,
+                  ) -> Response:
+    """Per-state statistics (visits, time in state, last outcome), as ``fsmscope replay`` counts them."""
+    root = entry.status.structure
+    if path is not None and structure.node_at(root, path) is None:
+        raise HTTPException(404, "machine %r has no state %r" % (entry.name, path[:200]))
+    data = await answer(hub, entry, lambda view: entry.stats.answer(view, root, path))
+    return Response(dumps(data), media_type="application/json")

@@ -76,6 +76,8 @@ export const api = {
   history: (name, params) => request("GET", machine(name) + "/history" + query(params)),
   /** Bands, ticks and runs of the machine's timeline: {since_t, until_t, buckets}. */
   timeline: (name, params) => request("GET", machine(name) + "/timeline" + query(params)),
+  /** Each state's visits, time in state and last outcome, as `fsmscope replay` counts them ({path}: only that one). */
+  summary: (name, path) => request("GET", machine(name) + "/summary" + query({ path })),
   /** Show a recorded pose in the 3D view (null: back to the live arm). */
   scenePose: (pose) => request("POST", "/api/scene/pose", { pose }),
   graphSvg: (name, expand) => request("GET", machine(name) + "/graph.svg" + query({ expand }), undefined, "text"),

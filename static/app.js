@@ -11,6 +11,7 @@ import { readLink, writeLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
 import { DebugBar } from "./debugger.js";
 import { Depth } from "./depth.js";
+import { DetailsPanel } from "./details.js";
 import { showMenu } from "./dialogs.js";
 import { GraphView } from "./graph.js";
 import { Lease } from "./lease.js";
@@ -22,6 +23,7 @@ import { Timeline } from "./timeline.js";
 import { TreeView } from "./tree.js";
 import { UserdataPanel, keyHistory } from "./userdata.js";
 import { SceneView } from "./scene.js";
+import { SearchPalette } from "./search.js";
 import { SCHEMA_VERSION } from "./schema.js";
 import { containers, parentPath } from "./status.js";
 import { Store, view } from "./store.js";
@@ -99,6 +101,10 @@ const showsLive = () => stream?.state === "live" && !playhead.past; // the debug
 const breakpoints = new Breakpoints(store, controls, showsLive);
 const debugBar = new DebugBar(store, controls, showsLive);
 const depth = new Depth($("depth"), store, () => graph.openPaths(), () => loadGraph());
+
+const details = new DetailsPanel($("details"), store, api);
+const search = new SearchPalette(store, () => shownStatus(), (entry) => goTo(entry));
+$("search-btn").addEventListener("click", () => search.open());
 
 // ---------------------------------------------------------------- the machine shown and its stream
 
@@ -221,6 +227,21 @@ function select(path) {
   queueRender();
 }
 
+/** A search's choice: a userdata key shows its container's userdata; a state, container or outcome (its
+ * state) is drawn (the containers on its path opened), brought into view and selected. */
+async function goTo(entry) {
+  if (entry.kind === "key") {
+    userdata.show(entry.path);
+    queueRender();
+    return;
+  }
+  $("follow").checked = false; // the user looks elsewhere than the active state
+  graph.follow = false;
+  await depth.reveal(entry.path);
+  select(entry.path);
+  graph.reveal(graph.stateElement(entry.path));
+}
+
 function stateMenu(path, x, y) {
   const node = store.nodes.get(path);
   select(path);
@@ -314,6 +335,7 @@ function render() {
   const marks = debugMarks(s);
   graph.apply({ ...shown, ...marks, selected: store.selected });
   tree.update(s, shown.failed, marks);
+  details.update();
   if (playhead.past && !playhead.window) log.freeze();
   else log.showPast(playhead.past ? playhead.window : null);
   log.flush();

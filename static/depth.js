@@ -41,6 +41,19 @@ export class Depth {
     this.select.value = values.includes(current) ? current : "auto";
   }
 
+  /** Draw open every container on the way to `path` (a search's choice, to be shown); resolves when it
+   * is drawn, at once when they are drawn open already. */
+  reveal(path) {
+    const open = new Set(this.drawnOpen());
+    const needed = [];
+    for (let p = parentPath(path); p; p = parentPath(p)) if (!open.has(p) && this.store.nodes.has(p)) needed.push(p);
+    if (!needed.length) return Promise.resolve();
+    if (!this.expand) this.expand = new Set([...open, this.store.status.root_path]);
+    for (const p of needed) this.expand.add(p);
+    this.select.value = "custom";
+    return Promise.resolve(this.changed(false));
+  }
+
   /** Open the container at `path` or close it (`isCluster`: it is drawn open). */
   toggle(path, isCluster) {
     const root = this.store.status.root_path;

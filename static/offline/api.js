@@ -21,6 +21,7 @@ export const api = {
   history: (name, params) => answer(() => recorded(name).history(params)),
   timeline: (name, params) => answer(() => recorded(name).timeline(params)),
   scenePose: () => Promise.reject(new ApiError(404, "this file has no 3D view")),
+  summary: () => Promise.reject(new ApiError(404, "an exported run holds no state statistics")),
   graphSvg: (name, expand) => answer(() => recorded(name).graphSvg(expand)),
   preempt: refuse,
   setInitialState: refuse,

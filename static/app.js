@@ -6,6 +6,7 @@
 import { api } from "./api.js";
 import { Audit } from "./audit.js";
 import { showBadge } from "./badge.js";
+import { Breadcrumb } from "./breadcrumb.js";
 import { Breakpoints, debugMarks } from "./breakpoints.js";
 import { readLink, writeLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
@@ -16,6 +17,8 @@ import { showMenu } from "./dialogs.js";
 import { GraphView } from "./graph.js";
 import { Lease } from "./lease.js";
 import { Machines, isReplay, showRunState } from "./machines.js";
+import { Minimap } from "./minimap.js";
+import { Panes } from "./panes.js";
 import { RunNotices, notice } from "./notice.js";
 import { EventLog } from "./eventlog.js";
 import { Playhead } from "./timetravel.js";
@@ -47,11 +50,24 @@ const graph = new GraphView($("graph"), {
   select: (path) => select(path),
   contextmenu: (path, x, y) => stateMenu(path, x, y),
   toggle: (path, isCluster) => depth.toggle(path, isCluster),
-  userPanned: () => {
-    $("follow").checked = false;
-    graph.follow = false;
+  userPanned: () => stopFollowing(),
+});
+function stopFollowing() {
+  $("follow").checked = false;
+  graph.follow = false;
+}
+new Breadcrumb($("crumb-bar"), $("fit"), graph, {
+  label: (path) => store.nodes.get(path)?.label ?? path,
+  fit: (path) => {
+    stopFollowing();
+    graph.fitPath(path);
   },
 });
+new Minimap($("minimap"), graph, (x, y) => {
+  stopFollowing();
+  graph.centreOn(x, y);
+});
+new Panes(document.querySelector("main.layout"));
 const tree = new TreeView($("tree"), {
   select: (path) => select(path),
   contextmenu: (path, x, y) => stateMenu(path, x, y),
@@ -100,7 +116,7 @@ $("audit-btn").addEventListener("click", () => audit.open());
 const showsLive = () => stream?.state === "live" && !playhead.past; // the debugger controls only what it shows
 const breakpoints = new Breakpoints(store, controls, showsLive);
 const debugBar = new DebugBar(store, controls, showsLive);
-const depth = new Depth($("depth"), store, () => graph.openPaths(), () => loadGraph());
+const depth = new Depth($("depth"), store, () => graph.openPaths(), (semantic) => loadGraph(semantic));
 
 const details = new DetailsPanel($("details"), store, api);
 const search = new SearchPalette(store, () => shownStatus(), (entry) => goTo(entry));
@@ -174,14 +190,19 @@ function structureChanged() {
   loadGraph();
 }
 
-/** Draw the layout of the structure with the containers `depth` opens (the server lays it out). */
-async function loadGraph() {
+/** Draw the layout of the structure with the containers `depth` opens (the server lays it out);
+ * `semantic`: opened or closed as the machine moved: what the user looks at stays where it is. */
+async function loadGraph(semantic = false) {
   const name = store.name;
   if (!store.status.structure) return;
   const expand = depth.paths();
   const key = JSON.stringify([name, store.structureKey, expand]);
   try {
-    if (await graph.load(key, () => api.graphSvg(name, expand))) queueRender();
+    const anchor = semantic ? store.selected || graph.activePath : null;
+    if (await graph.load(key, () => api.graphSvg(name, expand), anchor)) {
+      depth.laidOut();
+      queueRender();
+    }
   } catch (err) {
     if (name !== store.name) return;
     const text = "Could not draw the graph: " + (err.detail || err.message);
@@ -334,8 +355,10 @@ function render() {
   const shown = view(s);
   const marks = debugMarks(s);
   graph.apply({ ...shown, ...marks, selected: store.selected });
+  depth.show(shown.running, store.selected);
   tree.update(s, shown.failed, marks);
   details.update();
+  if (graph.follow && graph.activePath) tree.reveal(graph.activePath);
   if (playhead.past && !playhead.window) log.freeze();
   else log.showPast(playhead.past ? playhead.window : null);
   log.flush();
@@ -351,8 +374,9 @@ function render() {
 // ---------------------------------------------------------------- go
 
 $("fit").addEventListener("click", () => graph.fit());
-$("zoom-in").addEventListener("click", () => graph.zoom(1.25));
-$("zoom-out").addEventListener("click", () => graph.zoom(0.8));
+$("zoom-in").addEventListener("click", () => graph.zoomStep(1));
+$("zoom-out").addEventListener("click", () => graph.zoomStep(-1));
+$("zoom-readable").addEventListener("click", () => graph.zoomReadable());
 $("follow").addEventListener("change", (e) => {
   graph.follow = e.target.checked;
   queueRender();
@@ -360,8 +384,9 @@ $("follow").addEventListener("change", (e) => {
 document.addEventListener("keydown", (e) => {
   if (e.target.closest("input, textarea, select, dialog")) return;
   if (e.key === "f") graph.fit();
-  else if (e.key === "+" || e.key === "=") graph.zoom(1.25);
-  else if (e.key === "-") graph.zoom(0.8);
+  else if (e.key === "+" || e.key === "=") graph.zoomStep(1);
+  else if (e.key === "-") graph.zoomStep(-1);
+  else if (e.key === "r") graph.zoomReadable();
 });
 setInterval(updateBadge, 500);
 setInterval(() => {

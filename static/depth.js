@@ -1,7 +1,9 @@
 // Which containers the graph draws open: the depth selector (auto, 1..N, custom) and a double-click
-// that opens or closes one container.
+// that opens or closes one container. "auto" is the server's default (every container open) when
+// that default opens everything; when it does not (a big machine), semantic zoom (semantic_zoom.js).
 
 import { h } from "./dom.js";
+import { SemanticZoom } from "./semantic_zoom.js";
 import { containers, parentPath } from "./status.js";
 
 export class Depth {
@@ -9,30 +11,52 @@ export class Depth {
    * @param {HTMLSelectElement} select the depth selector
    * @param {Store} store the machine shown (store.js)
    * @param {() => string[]} drawnOpen the containers the graph shown draws open
-   * @param {() => void} changed called when another set of containers is to be drawn open
+   * @param {(semantic: boolean) => Promise<unknown>} changed called when another set of containers is
+   *   to be drawn open (`semantic`: by semantic zoom, as the machine moves); resolves when it is drawn
    */
   constructor(select, store, drawnOpen, changed) {
     this.select = select;
     this.store = store;
     this.drawnOpen = drawnOpen;
     this.changed = changed;
-    this.expand = null; // null: the server's default; else a Set of container paths drawn open
+    this.expand = null; // null: "auto"; else a Set of container paths drawn open
+    this.semantic = new SemanticZoom(() => changed(true));
+    this.semanticOn = false; // "auto" is semantic zoom: the server's default left containers closed
     select.addEventListener("change", () => this._chosen(select.value));
   }
 
   /** The containers to draw open, sorted; null: the server's default. */
   paths() {
-    return this.expand ? [...this.expand].sort() : null;
+    if (this.expand) return [...this.expand].sort();
+    return this.semanticOn ? this.semantic.paths() : null;
   }
 
   /** Another machine is shown: back to the server's default. */
   reset() {
     this.expand = null;
+    this.semanticOn = false;
+    this.semantic.reset(null);
+  }
+
+  /** A drawing is in: under "auto", one that leaves containers closed turns semantic zoom on. */
+  laidOut() {
+    if (this.expand || this.semanticOn || !this.store.status.structure) return;
+    const all = [...containers(this.store.status.structure)].length;
+    if (this.drawnOpen().length >= all) return;
+    this.semanticOn = true;
+    this.semantic.reset(this.store.status.root_path);
+  }
+
+  /** The instant shown (its running containers, the selection): semantic zoom follows it. */
+  show(running, selected) {
+    if (this.semanticOn && !this.expand) this.semantic.show(running, selected);
   }
 
   /** A new structure: forget the containers it no longer has, offer one depth per level of them. */
   restructured() {
     const nodes = this.store.nodes;
+    this.semanticOn = false;
+    this.semantic.reset(null);
     if (this.expand) this.expand = new Set([...this.expand].filter((p) => nodes.has(p)));
     const max = [...containers(this.store.status.structure)].reduce((m, n) => Math.max(m, this._depthOf(n.path) + 1), 1);
     const current = this.select.value;
@@ -70,16 +94,18 @@ export class Depth {
       for (let p = path; p; p = parentPath(p)) this.expand.add(p);
     }
     this.select.value = "custom";
-    this.changed();
+    this.changed(false);
   }
 
   _chosen(value) {
-    if (value === "auto") this.expand = null;
-    else if (value !== "custom") {
+    if (value === "auto") {
+      this.expand = null;
+      if (this.semanticOn) this.semantic.reset(this.store.status.root_path);
+    } else if (value !== "custom") {
       const d = Number(value);
       this.expand = new Set([...containers(this.store.status.structure)].map((n) => n.path).filter((p) => this._depthOf(p) < d));
     }
-    this.changed();
+    this.changed(false);
   }
 
   _depthOf(path) {

@@ -3,55 +3,20 @@
 // (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
 // the layout never moves when only the status changes; the marks are drawn by an overlay of copies
 // (graph_marks.js), so the drawing itself never repaints. Pan (drag) and zoom (wheel) act on the
-// viewBox of both. One module (about 300 lines): loading, marking and pan/zoom all act on the same
-// inlined SVG and its element index.
+// viewBox of both; a fit keeps labels readable (graph_geometry.js), a new layout of the same machine
+// can keep one element where it was on screen (semantic zoom). It tells its host what changed
+// ("graph:layout", "graph:view", "graph:focus", "graph:fit" events), which the minimap and the
+// breadcrumb (graph_nav.js) follow. One module (about 330 lines): loading, marking and pan/zoom all
+// act on the same inlined SVG and its element index.
 
+import { anchorAfter, anchorBefore, readableFit } from "./graph_fit.js";
+import { COMFORT_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox } from "./graph_geometry.js";
 import { GraphMarks } from "./graph_marks.js";
 import { containerId, outcomeId, stateId } from "./schema.js";
 import { parentPath } from "./status.js";
+import { parseSvg } from "./svg_safe.js";
 
-const SVG_NS = "http://www.w3.org/2000/svg";
-const MAX_FIT_SCALE = 1.7; // px per SVG unit (pt): about 1.3 times Graphviz's natural size
-const DROP_ELEMENTS = new Set(["script", "foreignobject", "iframe", "object", "embed", "image", "use", "animate",
-  "set", "animatemotion", "animatetransform", "handler", "listener", "style"]);
-
-/** Remove anything active from a parsed SVG: scripts, foreign content, event handlers, external links. */
-export function sanitizeSvg(root) {
-  const doomed = [];
-  for (const el of [root, ...root.querySelectorAll("*")]) {
-    if (DROP_ELEMENTS.has(el.localName.toLowerCase())) {
-      doomed.push(el);
-      continue;
-    }
-    for (const attr of [...el.attributes]) {
-      const name = attr.name.toLowerCase();
-      const value = attr.value.trim().toLowerCase();
-      if (name.startsWith("on")
-          || ((name === "href" || name.endsWith(":href") || name === "src") && !value.startsWith("#"))
-          || (name === "style" && (value.includes("url(") || value.includes("javascript:")))) {
-        el.removeAttribute(attr.name);
-      }
-    }
-  }
-  for (const el of doomed) el.remove();
-  // Graphviz prefixes ids with "pageX,Y_" when it paginates; the contract's ids are without.
-  for (const el of root.querySelectorAll("[id]")) {
-    const m = /^page\d+,\d+_([scoe]:.*)$/s.exec(el.id);
-    if (m) el.id = m[1];
-  }
-  return root;
-}
-
-/** Parse SVG text into a sanitized <svg> element of this document (never innerHTML). */
-export function parseSvg(text) {
-  const doc = new DOMParser().parseFromString(text, "image/svg+xml");
-  const svg = doc.documentElement;
-  if (!svg || svg.localName !== "svg" || svg.namespaceURI !== SVG_NS || doc.querySelector("parsererror")) {
-    throw new Error("the server's graph is not valid SVG");
-  }
-  sanitizeSvg(svg);
-  return document.importNode(svg, true);
-}
+export { parseSvg, sanitizeSvg } from "./svg_safe.js";
 
 export class GraphView {
   /**
@@ -70,16 +35,28 @@ export class GraphView {
     this.pathOf = new Map(); // element id -> the path of the state or container it stands for
     this.follow = true;
     this.loadToken = 0;
+    this.clusters = []; // the open containers' frames in user space ({path, box}), parents first
+    this.activePath = null; // the deepest active state
+    this.selectedPath = null;
     this._bindPointer();
   }
 
-  /** Load the layout for `key` (a string naming structure + expand set) unless already shown. */
-  async load(key, fetchSvg) {
+  _emit(type, detail) {
+    this.host.dispatchEvent(new CustomEvent("graph:" + type, { detail }));
+  }
+
+  /**
+   * Load the layout for `key` (a string naming structure + expand set) unless already shown.
+   * @param {string|null} anchorPath keep this state (or its closest drawn ancestor) where it is on
+   *   screen, at the same scale; null: fit the new drawing
+   */
+  async load(key, fetchSvg, anchorPath = null) {
     if (key === this.key) return false;
     const token = ++this.loadToken;
     const text = await fetchSvg();
     if (token !== this.loadToken) return false; // a newer load started meanwhile
     const svg = parseSvg(text);
+    const anchor = anchorPath && this.svg ? anchorBefore(this, anchorPath) : null;
     const vb = svg.viewBox.baseVal;
     let base;
     if (vb && vb.width > 0) {
@@ -98,7 +75,12 @@ export class GraphView {
     this.key = key;
     this.classed = new Map();
     this.host.replaceChildren(svg, this.marks.svg);
-    this.fit();
+    this.clusters = clusterBoxes(svg, this.pathOf);
+    const rect = this._hostSize();
+    const anchored = anchor && rect ? anchorAfter(this, anchor, rect) : null;
+    if (anchored) this._setViewBox(anchored);
+    else this.fit();
+    this._emit("layout");
     return true;
   }
 
@@ -106,7 +88,10 @@ export class GraphView {
     this.svg = null;
     this.marks = null;
     this.key = null;
+    this.base = null;
+    this.clusters = [];
     this.classed = new Map();
+    this._emit("layout");
     const p = document.createElement("p");
     p.className = "graph-empty";
     p.textContent = message || "";
@@ -176,6 +161,11 @@ export class GraphView {
     }
     // Measured before anything is written, so reading the layout forces no style or layout.
     const pan = this.follow && deepest ? this._panFor(deepest.el) : null;
+    if (deepest?.path !== this.activePath || view.selected !== this.selectedPath) {
+      this.activePath = deepest?.path ?? null;
+      this.selectedPath = view.selected;
+      this._emit("focus");
+    }
     for (const path of view.running) {
       if (this.el(containerId(path))) active.add(containerId(path));
     }
@@ -224,19 +214,58 @@ export class GraphView {
     return { ...this.vb, x: this.vb.x + dx, y: this.vb.y + dy };
   }
 
-  /** Show the whole graph, but never larger than MAX_FIT_SCALE pixels per SVG unit (a tiny graph stays small). */
+  /** The host's size in px, or null while it has none (hidden). */
+  _hostSize() {
+    const rect = this.host.getBoundingClientRect();
+    return rect.width && rect.height ? rect : null;
+  }
+
+  /** Px per SVG unit of the view shown. */
+  scale() {
+    const rect = this._hostSize();
+    return rect && this.vb ? Math.min(rect.width / this.vb.w, rect.height / this.vb.h) : 1;
+  }
+
+  /**
+   * Show the whole graph, never larger than MAX_FIT_SCALE (a tiny graph stays small) and never so
+   * small that labels cannot be read (graph_fit.js); says what it shows ("graph:fit": a sentence, or
+   * "" for the whole graph).
+   */
   fit() {
     if (!this.base) return;
-    const pad = Math.max(this.base.w, this.base.h) * 0.02;
-    let vb = { x: this.base.x - pad, y: this.base.y - pad, w: this.base.w + 2 * pad, h: this.base.h + 2 * pad };
-    const rect = this.host.getBoundingClientRect();
-    const scale = Math.min(rect.width / vb.w, rect.height / vb.h);
-    if (rect.width && rect.height && scale > MAX_FIT_SCALE) {
-      const w = rect.width / MAX_FIT_SCALE;
-      const h = rect.height / MAX_FIT_SCALE;
-      vb = { x: vb.x + vb.w / 2 - w / 2, y: vb.y + Math.min(vb.h / 2 - h / 2, 0), w, h };
-    }
+    const rect = this._hostSize();
+    const { vb, note } = rect ? readableFit(this, rect) : { vb: { ...this.base }, note: "" };
     this._setViewBox(vb);
+    this._emit("fit", note);
+  }
+
+  /** Show `box` (user space) whole, centred, at most MAX_FIT_SCALE. */
+  fitBox(box) {
+    const rect = this._hostSize();
+    if (rect) this._setViewBox(fitView(box, rect.width, rect.height));
+  }
+
+  /** Fit the open container at `path` (its frame), or the element that stands for it. */
+  fitPath(path) {
+    const cluster = this.clusters.find((c) => c.path === path);
+    const el = cluster ? null : this.stateElement(path);
+    if (cluster || el) this.fitBox(cluster ? cluster.box : userBox(el, this.svg));
+  }
+
+  /** Pan, at the same scale, so that (x, y) of user space is the view's centre. */
+  centreOn(x, y) {
+    if (!this.vb) return;
+    this._setViewBox({ ...this.vb, x: x - this.vb.w / 2, y: y - this.vb.h / 2 });
+  }
+
+  /** `steps` zoom steps in (positive) or out (negative), about the view's centre. */
+  zoomStep(steps) {
+    this.zoom(ZOOM_STEP ** steps);
+  }
+
+  /** Zoom, about the view's centre, to labels of a comfortable size (13 px). */
+  zoomReadable() {
+    this.zoom(COMFORT_SCALE / this.scale());
   }
 
   zoom(factor, clientX, clientY) {
@@ -247,7 +276,7 @@ export class GraphView {
       clientY = rect.top + rect.height / 2;
     }
     const p = this._toUser(clientX, clientY);
-    const w = Math.min(Math.max(this.vb.w / factor, this.base.w / 50), this.base.w * 20);
+    const w = Math.min(Math.max(this.vb.w / factor, this.base.w / 50, rect.width / 8), this.base.w * 20);
     const f = w / this.vb.w;
     this._setViewBox({ x: p.x - (p.x - this.vb.x) * f, y: p.y - (p.y - this.vb.y) * f, w, h: this.vb.h * f });
   }
@@ -264,6 +293,7 @@ export class GraphView {
     const text = `${vb.x} ${vb.y} ${vb.w} ${vb.h}`;
     this.svg.setAttribute("viewBox", text);
     this.marks.setViewBox(text);
+    this._emit("view");
   }
 
   _target(event) {
@@ -281,7 +311,8 @@ export class GraphView {
     host.addEventListener("wheel", (e) => {
       if (!this.svg) return;
       e.preventDefault();
-      this.zoom(Math.exp(-e.deltaY * (e.deltaMode === 1 ? 0.05 : 0.0015)), e.clientX, e.clientY);
+      // A wheel notch (100 px, or 3 lines) is one zoom step.
+      this.zoom(ZOOM_STEP ** (-e.deltaY / (e.deltaMode === 1 ? 3 : 100)), e.clientX, e.clientY);
     }, { passive: false });
     host.addEventListener("pointerdown", (e) => {
       if (!this.svg || e.button !== 0) return;

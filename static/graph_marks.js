@@ -9,22 +9,10 @@
 // 606 states (1,400 elements) that was 15 ms of every frame (bench/timetravel_browser.py), and
 // the overlay holds a few elements.
 
+import { placement } from "./graph_geometry.js";
+
 const SVG_NS = "http://www.w3.org/2000/svg";
 const KINDS = ["cluster", "edge", "node"]; // the overlay's layers, drawn in this order
-
-/** The transform from an element's own coordinates to its <svg>'s user space (read from the
- * attributes: no layout). */
-function placement(el, root) {
-  let matrix = new DOMMatrix();
-  for (let e = el; e && e !== root; e = e.parentElement) {
-    const list = e.transform?.baseVal;
-    if (!list) continue;
-    let own = new DOMMatrix();
-    for (let i = 0; i < list.numberOfItems; i++) own = own.multiply(DOMMatrix.fromMatrix(list.getItem(i).matrix));
-    matrix = own.multiply(matrix);
-  }
-  return matrix;
-}
 
 /** What a copy draws: a node's or an edge's shapes and label; a cluster's frame and label only (its
  * children are drawn, and marked, on their own). */

@@ -31,6 +31,7 @@ export class TreeView {
 
   build(structure) {
     this.rows.clear();
+    this.revealed = null;
     if (!structure) {
       this.host.replaceChildren(h("p", { class: "empty", text: "No structure yet." }));
       return;
@@ -89,6 +90,19 @@ export class TreeView {
       const text = entry && !entry.running && entry.outcome ? "→ " + entry.outcome : "";
       if (out.textContent !== text) out.textContent = text;
     }
+  }
+
+  /** Scroll the row of `path` into the middle of the tree when it is out of view (Follow active);
+   * a collapsed branch stays collapsed. */
+  reveal(path) {
+    if (path === this.revealed) return;
+    this.revealed = path;
+    const row = this.rows.get(path);
+    if (!row || !row.offsetParent) return;
+    const box = row.getBoundingClientRect();
+    const view = this.host.getBoundingClientRect();
+    if (box.top >= view.top && box.bottom <= view.bottom) return;
+    this.host.scrollTop += box.top - view.top - (view.height - box.height) / 2;
   }
 
   select(path) {

@@ -1,0 +1,81 @@
+// Which view box the graph shows when it is fitted, and when a new layout replaces the drawing: a
+// fit that keeps labels readable on a big machine, and an anchor that keeps one element where it was
+// on screen across a re-layout (Graphviz lays the whole drawing out again: without it, what stays
+// open jumps). Functions of a GraphView `g` (graph.js): its base, clusters, elements and scale.
+
+import { COMFORT_SCALE, LABEL_PT, MAX_FIT_SCALE, READABLE_SCALE, fitScale, fitView, userBox, viewAt } from "./graph_geometry.js";
+import { containerId, stateId } from "./schema.js";
+import { parentPath } from "./status.js";
+
+/** The last segment of a path: the state's name, for what the page says. */
+const nameOf = (path) => path.slice(path.lastIndexOf("/") + 1);
+
+/** The frame of the deepest open container holding `path` (itself included), the root's excluded. */
+function clusterOf(g, path) {
+  for (let p = path; p; p = parentPath(p)) {
+    const index = g.clusters.findIndex((c) => c.path === p);
+    if (index >= 0) return index === 0 ? null : g.clusters[index];
+  }
+  return null;
+}
+
+/**
+ * The whole drawing, centred (at most MAX_FIT_SCALE, a small one at the top); when its labels would
+ * be under READABLE_PX: the container of the selection (or of the active state), or, too big as well,
+ * that state (or the drawing's top left) with labels of 13 px. `note` says which ("" for the whole).
+ * @param {DOMRect} rect the host's size
+ * @returns {{vb: import("./graph_geometry.js").Box, note: string}}
+ */
+export function readableFit(g, rect) {
+  const base = g.base;
+  const whole = fitScale(base, rect.width, rect.height);
+  if (whole >= READABLE_SCALE) {
+    const vb = fitView(base, rect.width, rect.height);
+    if (whole > MAX_FIT_SCALE) vb.y = base.y - 8 / MAX_FIT_SCALE; // a small graph sits at the top
+    return { vb, note: "" };
+  }
+  const tiny = `the whole graph would have ${(whole * LABEL_PT).toFixed(1)} px labels (− zooms out)`;
+  const focus = g.selectedPath || g.activePath;
+  const cluster = focus ? clusterOf(g, focus) : null;
+  const clusterScale = cluster ? fitScale(cluster.box, rect.width, rect.height) : 0;
+  if (cluster && clusterScale >= READABLE_SCALE) {
+    return { vb: fitView(cluster.box, rect.width, rect.height), note: `Fit shows ${nameOf(cluster.path)}: ${tiny}` };
+  }
+  const el = focus ? g.stateElement(focus) : null;
+  if (!el) {
+    const vb = { x: base.x - 8, y: base.y - 8, w: rect.width / COMFORT_SCALE, h: rect.height / COMFORT_SCALE };
+    return { vb, note: `Fit shows the top left: ${tiny}` };
+  }
+  const box = userBox(el, g.svg);
+  return { vb: viewAt(box.x + box.w / 2, box.y + box.h / 2, COMFORT_SCALE, rect.width, rect.height),
+    note: `Fit shows ${nameOf(g.pathOf.get(el.id) ?? focus)}: ${tiny}` };
+}
+
+/** Where the elements standing for `path` and its ancestors are on screen before a re-layout: a node
+ * by its centre, an open container by its top left corner (it grows right and down when a child
+ * opens); null when none is drawn. */
+export function anchorBefore(g, path) {
+  const spots = [];
+  for (let p = path; p; p = parentPath(p)) {
+    for (const id of [stateId(p), containerId(p)]) {
+      const el = g.el(id);
+      if (!el) continue;
+      const r = el.getBoundingClientRect();
+      const cluster = id !== stateId(p);
+      spots.push({ id, cluster, x: cluster ? r.left : r.left + r.width / 2, y: cluster ? r.top : r.top + r.height / 2 });
+    }
+  }
+  return spots.length ? { spots, scale: g.scale() } : null;
+}
+
+/** The view box of the new drawing, at the old scale, that puts the first of the anchor's elements it
+ * still has where it was on screen; null when it has none of them. */
+export function anchorAfter(g, { spots, scale }, rect) {
+  const spot = spots.find((s) => g.el(s.id));
+  if (!spot) return null;
+  const base = g.base;
+  g._setViewBox(viewAt(base.x + base.w / 2, base.y + base.h / 2, scale, rect.width, rect.height));
+  const r = g.el(spot.id).getBoundingClientRect();
+  const [x, y] = spot.cluster ? [r.left, r.top] : [r.left + r.width / 2, r.top + r.height / 2];
+  return { ...g.vb, x: g.vb.x + (x - spot.x) / scale, y: g.vb.y + (y - spot.y) / scale };
+}

@@ -1,0 +1,96 @@
+// The minimap: the whole drawing's outline (its open containers' frames, drawn once per layout), the
+// rectangle the graph pane shows and a dot on the active state; a click or a drag on it pans there.
+// It follows the GraphView's events (graph.js), redrawn at most once per animation frame, and reads
+// the active state's box once per element and layout (getBBox), so following a fast machine costs a
+// few attribute writes a frame.
+
+import { userBox } from "./graph_geometry.js";
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+
+function svgEl(name, attributes = {}) {
+  const el = document.createElementNS(SVG_NS, name);
+  for (const [key, value] of Object.entries(attributes)) el.setAttribute(key, String(value));
+  return el;
+}
+
+export class Minimap {
+  /**
+   * @param {HTMLElement} host the minimap's box (over the graph pane)
+   * @param {import("./graph.js").GraphView} graph
+   * @param {(x: number, y: number) => void} pan centre the graph on this point of its user space
+   */
+  constructor(host, graph, pan) {
+    this.host = host;
+    this.graph = graph;
+    this.svg = host.appendChild(svgEl("svg", { preserveAspectRatio: "xMidYMid meet", "aria-hidden": "true" }));
+    this.outline = this.svg.appendChild(svgEl("g", { class: "mm-outline" }));
+    this.view = this.svg.appendChild(svgEl("rect", { class: "mm-view" }));
+    this.dot = this.svg.appendChild(svgEl("circle", { class: "mm-active", r: 0 }));
+    this.boxes = new Map(); // element id -> its box in user space, for this layout
+    this.queued = false;
+    graph.host.addEventListener("graph:layout", () => this._draw());
+    for (const type of ["graph:view", "graph:focus"]) graph.host.addEventListener(type, () => this._queue());
+    this._bindPointer(pan);
+  }
+
+  /** The outline of the layout shown, once per layout. */
+  _draw() {
+    const { base, clusters } = this.graph;
+    this.boxes = new Map();
+    this.host.hidden = !base;
+    if (!base) return;
+    this.svg.setAttribute("viewBox", `${base.x} ${base.y} ${base.w} ${base.h}`);
+    this.outline.replaceChildren(...clusters.map(({ box }) => svgEl("rect", { x: box.x, y: box.y, width: box.w, height: box.h })));
+    this.dotRadius = Math.max(base.w, base.h) / 60;
+    this._queue();
+  }
+
+  _queue() {
+    if (this.queued || !this.graph.base) return;
+    this.queued = true;
+    requestAnimationFrame(() => {
+      this.queued = false;
+      this._update();
+    });
+  }
+
+  /** The viewport's rectangle and the active state's dot. */
+  _update() {
+    const { vb, svg, activePath } = this.graph;
+    if (!vb || !svg) return;
+    for (const [name, value] of [["x", vb.x], ["y", vb.y], ["width", vb.w], ["height", vb.h]]) this.view.setAttribute(name, value);
+    const el = activePath ? this.graph.stateElement(activePath) : null;
+    if (!el) {
+      this.dot.setAttribute("r", 0);
+      return;
+    }
+    let box = this.boxes.get(el.id);
+    if (!box) this.boxes.set(el.id, box = userBox(el, svg));
+    this.dot.setAttribute("cx", box.x + box.w / 2);
+    this.dot.setAttribute("cy", box.y + box.h / 2);
+    this.dot.setAttribute("r", Math.max(this.dotRadius, box.h / 2));
+  }
+
+  _bindPointer(pan) {
+    let dragging = false;
+    const panTo = (e) => {
+      const ctm = this.svg.getScreenCTM();
+      if (!ctm) return;
+      const p = new DOMPoint(e.clientX, e.clientY).matrixTransform(ctm.inverse());
+      pan(p.x, p.y);
+    };
+    this.svg.addEventListener("pointerdown", (e) => {
+      if (e.button !== 0 || !this.graph.base) return;
+      dragging = true;
+      this.svg.setPointerCapture(e.pointerId);
+      panTo(e);
+    });
+    this.svg.addEventListener("pointermove", (e) => {
+      if (dragging) panTo(e);
+    });
+    const end = () => { dragging = false; };
+    this.svg.addEventListener("pointerup", end);
+    this.svg.addEventListener("pointercancel", end);
+  }
+}

@@ -1,0 +1,44 @@
+// The server's SVG made inert before it enters the page: parsed as XML (never innerHTML), scripts,
+// foreign content, event handlers and external links removed.
+
+const SVG_NS = "http://www.w3.org/2000/svg";
+const DROP_ELEMENTS = new Set(["script", "foreignobject", "iframe", "object", "embed", "image", "use", "animate",
+  "set", "animatemotion", "animatetransform", "handler", "listener", "style"]);
+
+/** Remove anything active from a parsed SVG: scripts, foreign content, event handlers, external links. */
+export function sanitizeSvg(root) {
+  const doomed = [];
+  for (const el of [root, ...root.querySelectorAll("*")]) {
+    if (DROP_ELEMENTS.has(el.localName.toLowerCase())) {
+      doomed.push(el);
+      continue;
+    }
+    for (const attr of [...el.attributes]) {
+      const name = attr.name.toLowerCase();
+      const value = attr.value.trim().toLowerCase();
+      if (name.startsWith("on")
+          || ((name === "href" || name.endsWith(":href") || name === "src") && !value.startsWith("#"))
+          || (name === "style" && (value.includes("url(") || value.includes("javascript:")))) {
+        el.removeAttribute(attr.name);
+      }
+    }
+  }
+  for (const el of doomed) el.remove();
+  // Graphviz prefixes ids with "pageX,Y_" when it paginates; the contract's ids are without.
+  for (const el of root.querySelectorAll("[id]")) {
+    const m = /^page\d+,\d+_([scoe]:.*)$/s.exec(el.id);
+    if (m) el.id = m[1];
+  }
+  return root;
+}
+
+/** Parse SVG text into a sanitized <svg> element of this document (never innerHTML). */
+export function parseSvg(text) {
+  const doc = new DOMParser().parseFromString(text, "image/svg+xml");
+  const svg = doc.documentElement;
+  if (!svg || svg.localName !== "svg" || svg.namespaceURI !== SVG_NS || doc.querySelector("parsererror")) {
+    throw new Error("the server's graph is not valid SVG");
+  }
+  sanitizeSvg(svg);
+  return document.importNode(svg, true);
+}

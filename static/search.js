@@ -89,6 +89,9 @@ export class SearchPalette {
     } else if (e.key === "Enter") {
       e.preventDefault();
       if (n) this._choose(this.current);
+    } else if (e.key === "Escape") { // a search field would only clear its text
+      e.preventDefault();
+      this.dialog.close();
     }
   }
 

@@ -61,6 +61,23 @@ def served_page(browser, machine, name: str, **entry):
 
 
 @contextlib.contextmanager
+def serving_while_running(machine, stop: threading.Event, name: str):
+    """A fresh server showing ``machine`` (as ``name``) while it runs in a thread, until ``stop`` is set at
+    the end: a machine of server.testing.big_machine, shared by the tests of a module."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    srv = ServerThread().start()
+    srv.hub.add_local(machine, name=name)
+    runner = threading.Thread(target=machine.execute)
+    runner.start()
+    try:
+        yield srv
+    finally:
+        stop.set()
+        runner.join(10)
+        srv.stop()
+
+
+@contextlib.contextmanager
 def page_while_waiting(browser, build, name: str):
     """A page watching the machine ``build(gate)`` makes, served alone, while it runs and waits for ``gate``
     (a threading.Event, set at the end)."""

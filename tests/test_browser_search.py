@@ -5,13 +5,11 @@ whose container names carry markup, in Chromium."""
 from __future__ import annotations
 
 import json
-import threading
 
 import fsm
 import pytest
-from browser_support import watch
+from browser_support import serving_while_running, watch
 from fsm.observation.schema import container_id, state_id
-from server.http_server import ServerThread
 from server.testing.big_machine import big_machine, count_states
 from server.testing.polling import wait_for
 
@@ -24,16 +22,9 @@ DEEP_LABEL = "W_1_2_0_3"
 @pytest.fixture(scope="module")
 def served():
     """A server showing 'big' while it runs (a leaf every 20 ms), stopped at the end."""
-    fsm.set_loggers(*(lambda msg: None,) * 4)
     sm, stop = big_machine(BRANCHING, DEPTH, LEAVES, tick=0.02, names=MARKUP)
-    srv = ServerThread().start()
-    srv.hub.add_local(sm, name="big")
-    runner = threading.Thread(target=sm.execute)
-    runner.start()
-    yield srv
-    stop.set()
-    runner.join(10)
-    srv.stop()
+    with serving_while_running(sm, stop, "big") as srv:
+        yield srv
 
 
 @pytest.fixture

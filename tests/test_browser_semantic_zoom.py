@@ -1,0 +1,164 @@
+"""A machine of several hundred states in the graph pane (issue 11): semantic zoom ("auto" opens the
+active path and closes idle branches, static/semantic_zoom.js), the view kept in place across its
+re-layouts (graph_fit.js), the breadcrumb of the container in view (breadcrumb.js), a fit that keeps
+labels readable, the minimap (minimap.js)."""
+
+from __future__ import annotations
+
+import threading
+
+import fsm
+import pytest
+from browser_support import watch
+from fsm.observation.schema import container_id
+from server.http_server import ServerThread
+from server.testing.big_machine import big_machine, count_states
+
+SHAPE = (3, 4, 6)  # branching, depth, leaves: 40 containers, 280 states
+TICK = 0.03  # seconds a leaf runs: the machine crosses a container in well under a second
+
+# The deepest active state of the status shown, and whether the graph draws it itself (not a closed
+# ancestor) inside the graph pane.
+ACTIVE_IN_VIEW = """() => {
+  const s = window.fsmscope.status;
+  const path = s.activePaths().sort((a, b) => b.length - a.length)[0];
+  const el = path && document.getElementById('s:' + path);
+  if (!el) return null;
+  const box = el.getBoundingClientRect();
+  const view = document.getElementById('graph').getBoundingClientRect();
+  const inside = box.left >= view.left && box.right <= view.right && box.top >= view.top && box.bottom <= view.bottom;
+  return { path, inside };
+}"""
+
+# The on-screen size (px) of the labels of the states in view: the font size times the drawing's scale.
+LABEL_PX = """() => {
+  const view = document.getElementById('graph').getBoundingClientRect();
+  return [...document.querySelectorAll('#graph svg.fsm-graph g.node text')].filter((t) => {
+    const b = t.getBoundingClientRect();
+    return b.left >= view.left && b.right <= view.right && b.top >= view.top && b.bottom <= view.bottom;
+  }).map((t) => parseFloat(t.getAttribute('font-size')) * t.getScreenCTM().a);
+}"""
+
+
+@pytest.fixture(scope="module")
+def served():
+    """A server with `big`, running until the module ends."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    sm, stop = big_machine(*SHAPE, tick=TICK)
+    assert count_states(*SHAPE) == 280
+    srv = ServerThread().start()
+    srv.hub.add_local(sm, name="big")
+    runner = threading.Thread(target=sm.execute)
+    runner.start()
+    yield srv
+    stop.set()
+    runner.join(10)
+    srv.stop()
+
+
+@pytest.fixture
+def page(browser, served):
+    page = watch(browser, served, "big")
+    page.wait_for_selector("#run-state.running")
+    yield page
+    assert not page.errors
+    page.close()
+
+
+def open_all(page) -> None:
+    """Choose the deepest depth: every container drawn open."""
+    page.select_option("#depth", page.eval_on_selector("#depth", "s => [...s.options].filter(o => /^\\d+$/.test(o.value)).pop().value"))
+    page.wait_for_function("() => document.querySelectorAll('#graph g.cluster').length === 40", timeout=30000)
+
+
+def test_semantic_zoom_draws_the_active_leaf_in_view_as_the_machine_moves_across_containers(page):
+    containers = set()
+    for _ in range(3):
+        seen = page.wait_for_function("""(known) => {
+          const r = (%s)();
+          const container = r && r.path.slice(0, r.path.lastIndexOf('/'));
+          return r && r.inside && !known.includes(container) ? container : null;
+        }""" % ACTIVE_IN_VIEW, arg=sorted(containers), timeout=20000)
+        containers.add(seen.json_value())
+    assert len(containers) == 3
+
+
+def test_semantic_zoom_leaves_idle_branches_closed(page):
+    page.wait_for_function("() => document.querySelectorAll('#graph g.cluster').length >= 3", timeout=20000)
+    assert page.evaluate("document.querySelectorAll('#graph g.cluster').length") < 40
+
+
+def test_a_relayout_keeps_the_selected_state_where_it_was_on_screen(page):
+    root = page.evaluate("window.fsmscope.status.root_path")
+    first = root + "/W_0"
+    page.uncheck("#follow")
+    page.click('.tree-row[data-path="%s"] .label' % first)
+    before = page.eval_on_selector('[id="s:%s"]' % first, "el => { window.__drawing = el.ownerSVGElement; const b = el.getBoundingClientRect(); return [b.x, b.y]; }")
+    page.wait_for_function("() => document.querySelector('#graph svg.fsm-graph') !== window.__drawing", timeout=20000)
+    after = page.eval_on_selector('[id="s:%s"]' % first, "el => { const b = el.getBoundingClientRect(); return [b.x, b.y]; }")
+    assert after == pytest.approx(before, abs=1.0)
+
+
+def test_the_breadcrumb_names_the_container_at_the_view_centre(page):
+    page.select_option("#depth", "2")
+    root = page.evaluate("window.fsmscope.status.root_path")
+    target = container_id(root + "/TASK_1")
+    page.wait_for_selector('#graph [id="%s"]' % target)
+    box = page.eval_on_selector('[id="%s"]' % target, "el => { const b = el.getBoundingClientRect(); return [b.x + b.width / 2, b.y + b.height / 2]; }")
+    view = page.eval_on_selector("#graph", "el => { const b = el.getBoundingClientRect(); return [b.x + b.width / 2, b.y + b.height / 2]; }")
+    page.mouse.move(*view)
+    page.mouse.down()
+    page.mouse.move(view[0] + (view[0] - box[0]), view[1] + (view[1] - box[1]), steps=5)
+    page.mouse.up()
+    page.wait_for_function("() => document.querySelector('.crumbs li:last-child')?.textContent === 'TASK_1'")
+    assert page.eval_on_selector_all(".crumbs li", "els => els.length") == 2
+
+
+def test_clicking_a_crumb_fits_its_container(page):
+    page.select_option("#depth", "2")
+    page.uncheck("#follow")
+    page.wait_for_selector(".crumbs button")
+    root = page.evaluate("window.fsmscope.status.root_path")
+    page.click('.crumbs button[data-path="%s"]' % root)
+    frame = page.eval_on_selector('[id="%s"] > polygon' % container_id(root), "el => { const b = el.getBoundingClientRect(); return [b.width, b.height]; }")
+    view = page.eval_on_selector("#graph", "el => { const b = el.getBoundingClientRect(); return [b.width, b.height]; }")
+    assert max(frame[0] / view[0], frame[1] / view[1]) == pytest.approx(1.0, abs=0.1)
+
+
+def test_fit_on_the_whole_open_machine_keeps_labels_readable(page):
+    open_all(page)
+    page.click("#fit")
+    sizes = page.evaluate(LABEL_PX)
+    assert sizes and min(sizes) >= 9
+
+
+def test_fit_says_what_it_shows_when_the_whole_would_be_unreadable(page):
+    open_all(page)
+    page.click("#fit")
+    assert "px labels" in page.text_content(".fit-note")
+    assert "px labels" in page.get_attribute("#fit", "title")
+
+
+def test_the_readable_zoom_gives_labels_of_13_px(page):
+    page.click("#zoom-out")
+    page.click("#zoom-readable")
+    assert page.evaluate(LABEL_PX)[0] == pytest.approx(13, abs=0.2)
+
+
+def test_the_minimap_outlines_the_part_of_the_drawing_in_view(page):
+    open_all(page)
+    page.click("#fit")
+    shown = page.eval_on_selector("#graph svg.fsm-graph", "svg => svg.getAttribute('viewBox').split(' ').map(Number)")
+    rect = page.eval_on_selector(".mm-view", "r => ['x', 'y', 'width', 'height'].map((a) => Number(r.getAttribute(a)))")
+    assert page.is_visible("#minimap")
+    assert rect == pytest.approx(shown, rel=1e-6)
+
+
+def test_clicking_the_minimap_centres_the_graph_there(page):
+    open_all(page)
+    page.click("#fit")
+    page.click("#minimap svg")  # its centre: the drawing's centre
+    vb = page.eval_on_selector("#graph svg.fsm-graph", "svg => svg.getAttribute('viewBox').split(' ').map(Number)")
+    base = page.eval_on_selector(".mm-outline rect", "r => ['x', 'y', 'width', 'height'].map((a) => Number(r.getAttribute(a)))")
+    assert vb[0] + vb[2] / 2 == pytest.approx(base[0] + base[2] / 2, abs=base[2] * 0.02)
+    assert page.is_checked("#follow") is False

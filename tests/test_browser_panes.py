@@ -4,29 +4,17 @@ than 182 px; and the hierarchy follows the active state (static/tree.js)."""
 
 from __future__ import annotations
 
-import threading
-
-import fsm
 import pytest
-from browser_support import watch
-from server.http_server import ServerThread
+from browser_support import serving_while_running, watch
 from server.testing.big_machine import big_machine
 from server.testing.browser import open_page
 
 
 @pytest.fixture(scope="module")
 def served():
-    """A server with `big` (280 states, so the hierarchy scrolls), running until the module ends."""
-    fsm.set_loggers(*(lambda msg: None,) * 4)
-    sm, stop = big_machine(3, 4, 6, tick=0.03)
-    srv = ServerThread().start()
-    srv.hub.add_local(sm, name="big")
-    runner = threading.Thread(target=sm.execute)
-    runner.start()
-    yield srv
-    stop.set()
-    runner.join(10)
-    srv.stop()
+    """A server with `big` (280 states), running until the module ends."""
+    with serving_while_running(*big_machine(3, 4, 6, tick=0.03), "big") as srv:
+        yield srv
 
 
 @pytest.fixture

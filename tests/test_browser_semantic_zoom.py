@@ -5,13 +5,9 @@ labels readable, the minimap (minimap.js)."""
 
 from __future__ import annotations
 
-import threading
-
-import fsm
 import pytest
-from browser_support import watch
+from browser_support import serving_while_running, watch
 from fsm.observation.schema import container_id
-from server.http_server import ServerThread
 from server.testing.big_machine import big_machine, count_states
 
 SHAPE = (3, 4, 6)  # branching, depth, leaves: 40 containers, 280 states
@@ -42,18 +38,10 @@ LABEL_PX = """() => {
 
 @pytest.fixture(scope="module")
 def served():
-    """A server with `big`, running until the module ends."""
-    fsm.set_loggers(*(lambda msg: None,) * 4)
-    sm, stop = big_machine(*SHAPE, tick=TICK)
+    """A server with `big` (280 states), running until the module ends."""
     assert count_states(*SHAPE) == 280
-    srv = ServerThread().start()
-    srv.hub.add_local(sm, name="big")
-    runner = threading.Thread(target=sm.execute)
-    runner.start()
-    yield srv
-    stop.set()
-    runner.join(10)
-    srv.stop()
+    with serving_while_running(*big_machine(*SHAPE, tick=TICK), "big") as srv:
+        yield srv
 
 
 @pytest.fixture
@@ -147,11 +135,14 @@ def test_the_readable_zoom_gives_labels_of_13_px(page):
 
 def test_the_minimap_outlines_the_part_of_the_drawing_in_view(page):
     open_all(page)
+    page.uncheck("#follow")  # the view stays where the fit put it
     page.click("#fit")
-    shown = page.eval_on_selector("#graph svg.fsm-graph", "svg => svg.getAttribute('viewBox').split(' ').map(Number)")
-    rect = page.eval_on_selector(".mm-view", "r => ['x', 'y', 'width', 'height'].map((a) => Number(r.getAttribute(a)))")
+    page.wait_for_function("""() => {
+      const shown = document.querySelector('#graph svg.fsm-graph').getAttribute('viewBox').split(' ').map(Number);
+      const rect = document.querySelector('.mm-view');
+      return ['x', 'y', 'width', 'height'].every((a, i) => Math.abs(Number(rect.getAttribute(a)) - shown[i]) < 1e-3);
+    }""")
     assert page.is_visible("#minimap")
-    assert rect == pytest.approx(shown, rel=1e-6)
 
 
 def test_clicking_the_minimap_centres_the_graph_there(page):

@@ -6,7 +6,7 @@
 // viewBox of both; a fit keeps labels readable (graph_geometry.js), a new layout of the same machine
 // can keep one element where it was on screen (semantic zoom). It tells its host what changed
 // ("graph:layout", "graph:view", "graph:focus", "graph:fit" events), which the minimap and the
-// breadcrumb (graph_nav.js) follow. One module (about 330 lines): loading, marking and pan/zoom all
+// breadcrumb (minimap.js, breadcrumb.js) follow. One module (about 360 lines): loading, marking and pan/zoom all
 // act on the same inlined SVG and its element index.
 
 import { anchorAfter, anchorBefore, readableFit } from "./graph_fit.js";

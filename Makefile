@@ -39,6 +39,8 @@ bench: install
 	$(PY) bench/timetravel.py
 	$(PY) bench/timetravel_browser.py
 	$(PY) bench/live_rewind.py
+	$(PY) bench/debugger.py
+	$(PY) bench/big_machine_browser.py
 	$(PY) bench/server.py
 	$(PY) bench/graph.py
 	$(PY) bench/sim.py

@@ -92,17 +92,16 @@ class Leases:
             lease = self._leases[name] = Lease(page, client, time.time(), self._clock())
             return lease, True, current
 
-    def admit(self, name: str, page: str | None) -> bool:
-        """Whether a control from ``page`` (None: a script) may act on machine ``name`` now: the lease is
-        free or the page's own (a sign of life). Raises LeaseHeld otherwise."""
+    def admit(self, name: str, page: str | None) -> None:
+        """Let a control from ``page`` (None: a script) act on machine ``name``: the lease is free or the
+        page's own (then it is a sign of life). Raises LeaseHeld otherwise."""
         with self._lock:
             current = self._leases.get(name)
             if current is None:
-                return True
+                return
             if current.page != page:
                 raise LeaseHeld(self._held_message(name, current))
             current.beat = self._clock()
-            return True
 
     def beat(self, name: str, page: str) -> Lease:
         """The holder's heartbeat; raises LeaseHeld when this page no longer holds the lease."""

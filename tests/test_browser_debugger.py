@@ -196,7 +196,7 @@ def test_a_condition_with_markup_is_shown_as_text(rounds):
 
 def test_pause_holds_the_machine_and_resume_lets_it_run_on(rounds):
     rounds.click("#pause-btn")
-    assert banner_saying(rounds).endswith(": paused")
+    assert banner_saying(rounds, "Paused in").endswith(": paused")
     assert rounds.is_disabled("#pause-btn")
     rounds.click("#resume-btn")
     rounds.wait_for_selector("#debug-bar", state="hidden")

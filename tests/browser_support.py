@@ -1,6 +1,7 @@
 """Helpers of the browser tests: the dashboard's page for a machine of a live server (or served alone), the
-active state as the graph shows it, the event log's filter, and Debian's Firefox over WebDriver
-BiDi. Chromium and the demo process are in server.testing (bench/ and docs/ use them too)."""
+active state as the graph shows it, the event log's filter, Debian's Firefox over WebDriver BiDi, and
+the one ``fsmscope demo`` process the demo's tests share (SharedDemo). Chromium and the demo process
+are in server.testing (bench/ and docs/ use them too)."""
 
 from __future__ import annotations
 
@@ -10,12 +11,15 @@ import re
 import signal
 import subprocess
 import threading
+import time
 import urllib.parse
 from pathlib import Path
 
 import fsm
+import httpx
 from server.testing.browser import open_page
 from server.http_server import ServerThread
+from server.testing.demo_process import DemoProcess
 from server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -102,6 +106,42 @@ def watch(browser, server, machine: str):
     page.wait_for_selector("#badge.live")
     assert page.input_value("#machine-picker") == machine
     return page
+
+
+@contextlib.contextmanager
+def watching(browser, server, machine: str, ready: str | None = None):
+    """A page showing ``machine`` of ``server`` with its stream live (and ``ready``, a selector, shown),
+    for one test; it must end without a script error, and is closed."""
+    page = watch(browser, server, machine)
+    try:
+        if ready is not None:
+            page.wait_for_selector(ready)
+        yield page
+        assert not page.errors
+    finally:
+        page.close()
+
+
+def as_page(http: httpx.Client, page) -> httpx.Client:
+    """``http`` sending the page's id: the operator lease (docs/debugging.md) is held by the page whose
+    controls took it, so the test's own requests come from that page."""
+    http.headers["X-Fsmscope-Page"] = page.evaluate("async () => (await import('/api.js')).PAGE_ID")
+    return http
+
+
+# The debugger banner's text, null while it is hidden.
+SHOWN_BANNER = """() => document.getElementById('debug-bar').hidden
+    ? null : document.querySelector('#debug-bar .debug-text').textContent"""
+
+
+def banner_saying(page, words: str = "", timeout: float = 8.0) -> str:
+    """The banner's text once it is shown saying ``words``; failing, what it said instead."""
+    def said() -> str | None:
+        text = page.evaluate(SHOWN_BANNER)
+        return text if text and words in text else None
+
+    return wait_for(said, timeout, interval=0.05,
+                    what=lambda: "the banner to say %r; it says %r" % (words, page.evaluate(SHOWN_BANNER)))
 
 
 FIREFOX = "/usr/bin/firefox-esr"
@@ -215,3 +255,94 @@ def filter_log(page, text: str = "", kinds=None) -> None:
     for kind in kinds or ():
         page.check("#log-kinds input[value=%s]" % kind)
     page.keyboard.press("Escape")
+
+
+# ---------------------------------------------------------------- the demo the tests share
+
+DEMO_MACHINE = "pick_place"
+FRESH_EPISODE = 1.5  # s: an episode (about 6 s at real time) begun this recently has seconds of it ahead
+
+
+class SharedDemo:
+    """One real ``fsmscope demo`` (real time, its default deadman) for the demo's tests of several
+    modules: started when a test first needs it (``process()``), stopped by tests/conftest.py after
+    the last test in a row that does (``stop()``). Whoever uses it leaves it as it was found:
+    ``let_go()`` after every test (no breakpoint, nothing held, no lease, the loop running)."""
+
+    PAGE = "tests-let-go"  # the page id of the requests that let the machine go
+
+    def __init__(self, directory: Path) -> None:
+        self.directory = directory
+        self.demo: DemoProcess | None = None
+        self.started = 0
+
+    def process(self) -> DemoProcess:
+        """The demo, started if it is not running; a demo that died is an error, never restarted quietly."""
+        if self.demo is None:
+            self.started += 1
+            self.demo = DemoProcess(self.directory / ("demo-%d.jsonl" % self.started))
+        elif self.demo.proc.poll() is not None:
+            raise RuntimeError("the shared demo exited with %s" % self.demo.proc.returncode)
+        return self.demo
+
+    def stop(self) -> int | None:
+        """Stop the demo as Ctrl-C does; its exit code (130: interrupted cleanly), None when none ran."""
+        demo, self.demo = self.demo, None
+        return None if demo is None else demo.stop()
+
+    def let_go(self, timeout: float = 30.0) -> None:
+        """Leave the demo as a fresh one is: no breakpoint, no hold, no lease (a lease left held would
+        make the deadman pause the machine for the next test), the episode loop running."""
+        if self.demo is None:
+            return
+        http = demo_client(self.demo, page=self.PAGE)
+        base = "/api/machines/" + DEMO_MACHINE
+        assert http.post(base + "/lease", json={"takeover": True}).status_code == 200
+        assert http.put(base + "/breakpoints", json={"breakpoints": []}).status_code == 200
+        assert http.post(base + "/resume").status_code == 202
+        assert http.delete(base + "/lease").status_code == 200
+
+        def running_free() -> bool:
+            machine = demo_machine(http)
+            if machine["running"]:
+                return not machine["held"]  # held: it stops after this episode; started again below
+            if machine["held"] or machine["outcome"] == "preempted":  # the loop waits for Start
+                http.post(base + "/start")
+                http.delete(base + "/lease")  # a start takes a free lease
+            return False
+
+        wait_for(running_free, timeout, interval=0.1, what="the shared demo to run its episodes again")
+        http.close()
+
+
+def demo_client(demo: DemoProcess, page: str | None = None) -> httpx.Client:
+    """An operator's client of ``demo`` (sending ``page`` as its page id, when given)."""
+    headers = {"Authorization": "Bearer " + demo.token}
+    if page is not None:
+        headers["X-Fsmscope-Page"] = page
+    return httpx.Client(base_url="http://127.0.0.1:%d" % demo.port, headers=headers, timeout=10)
+
+
+def demo_machine(http: httpx.Client) -> dict:
+    """The demo's machine as GET /api/machines lists it."""
+    return {m["name"]: m for m in http.get("/api/machines").json()}[DEMO_MACHINE]
+
+
+def episode_age(demo: DemoProcess) -> float | None:
+    """Seconds since the demo's running episode began (its first event); None between two episodes."""
+    with demo_client(demo) as http:
+        status = http.get("/api/machines/%s/status" % DEMO_MACHINE).json()
+        if not status["running"]:
+            return None
+        began = http.get("/api/machines/%s/status" % DEMO_MACHINE, params={"seq": status["run_seq"]}).json()
+        return time.time() - began["last_t"]
+
+
+def wait_for_a_fresh_episode(demo: DemoProcess, timeout: float = 30.0) -> None:
+    """Until the demo runs an episode begun less than FRESH_EPISODE s ago: seconds of it ahead, for a
+    control to land in."""
+    def fresh() -> bool:
+        age = episode_age(demo)
+        return age is not None and age <= FRESH_EPISODE
+
+    wait_for(fresh, timeout, interval=0.1, what="the demo to begin an episode")

@@ -1,5 +1,6 @@
 """Shared fixtures: captured log lines, the runtime's globals restored after every test, a live
-server, a private bus and its action servers, and Debian's Chromium for the browser tests."""
+server, a private bus and its action servers, Debian's Chromium for the browser tests, and one
+``fsmscope demo`` process shared by the demo's tests of several modules."""
 
 import os
 import shutil
@@ -75,11 +76,19 @@ def live_server():
         srv.stop()
 
 
+# Each origin in a renderer process of its own. Chromium keeps a same-site iframe, such as the 3D view
+# (viser, on another port of 127.0.0.1), in its page's process; with no GPU, three.js compiling its
+# shaders in software then holds that process's main thread, the dashboard's too, for 6 to 9 s after
+# every page load, and each test of a page with a 3D view waited that out. Origin isolation changes
+# nothing a page does or shows (the iframe was cross-origin already), only which process runs it.
+TEST_CHROMIUM_ARGS = ["--enable-features=StrictOriginIsolation"]
+
+
 @pytest.fixture(scope="module")
 def browser():
     """Debian's Chromium, shared by the tests of one module; skips when it, Playwright or Graphviz
     (the server draws the graph with dot) is missing. Playwright is imported here, not at collection."""
-    from server.testing.browser import CHROMIUM, launch_chromium
+    from server.testing.browser import CHROMIUM, CHROMIUM_ARGS
 
     playwright_api = pytest.importorskip("playwright.sync_api")
     if not os.path.exists(CHROMIUM):
@@ -87,7 +96,8 @@ def browser():
     if not shutil.which("dot"):
         pytest.skip("Graphviz's dot is not installed (make apt)")
     with playwright_api.sync_playwright() as pw:
-        chromium = launch_chromium(pw)
+        # server.testing.browser.launch_chromium, with TEST_CHROMIUM_ARGS (bench/ measures without them).
+        chromium = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS + TEST_CHROMIUM_ARGS, headless=True)
         yield chromium
         chromium.close()
 
@@ -105,3 +115,40 @@ def servers():
     yield made
     for server in made:
         server.shutdown(timeout=1.0)
+
+
+# The demo the tests share (browser_support.SharedDemo), made by the first test that needs it.
+_shared_demo: list = []
+
+
+@pytest.fixture(scope="session")
+def shared_demo(tmp_path_factory):
+    """One real ``fsmscope demo`` at real time (episodes of about 6 s, a pause of 1 s between them) for
+    the demo's tests of several modules: ``process()`` starts it, ``let_go()`` leaves it as it was
+    found. pytest_runtest_teardown below stops it after the last test in a row that uses it, so it
+    never runs (and costs CPU) behind the tests that do not."""
+    from browser_support import SharedDemo
+
+    shared = SharedDemo(tmp_path_factory.mktemp("shared-demo"))
+    _shared_demo.append(shared)
+    yield shared
+    _shared_demo.remove(shared)
+    assert shared.stop() in (None, 130)  # interrupted, cleanly
+
+
+@pytest.fixture
+def demo(shared_demo):
+    """The shared demo's process, let go after the test (no breakpoint, no hold, no lease, running)."""
+    yield shared_demo.process()
+    shared_demo.let_go()
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_teardown(item, nextitem):
+    """After the last test in a row that uses the shared demo (and its fixtures' teardown), stop it."""
+    try:
+        return (yield)
+    finally:
+        if _shared_demo and "shared_demo" in item.fixturenames and (
+                nextitem is None or "shared_demo" not in nextitem.fixturenames):
+            assert _shared_demo[0].stop() in (None, 130)  # interrupted, cleanly

@@ -1,23 +1,19 @@
 """The debugger in the page (docs/debugging.md): breakpoints from the state menu and their dialog,
 their marks on the graph and the tree, the banner saying where and why the machine holds, and
 Pause, Resume, Step, Step over and Force outcome; hidden from a viewer, disabled when looking back.
-A small local machine for the page's parts, the demo (a real ``fsmscope demo`` process) for the
-issue's scenario: a conditional breakpoint set from the page holds the arm still, then step, force
-and resume drive it."""
+A small local machine for the page's parts (the issue's scenario on the demo is in
+test_browser_debugger_demo.py)."""
 
 from __future__ import annotations
 
 import json
 import threading
 import time
-import urllib.parse
 
 import fsm
-import httpx
 import pytest
-from browser_support import served_page
+from browser_support import as_page, banner_saying, served_page
 from server.testing.browser import open_page
-from server.testing.demo_process import DemoProcess
 from server.testing.polling import wait_for
 from server_support import client
 
@@ -49,13 +45,6 @@ def rounds_machine() -> tuple[fsm.StateMachine, threading.Event]:
         fsm.StateMachine.add("C", fsm.CBState(count, outcomes=["again", "stop"], input_keys=["n"], output_keys=["n"]),
                              {"again": "SUB", "stop": "done"})
     return sm, stop
-
-
-def as_page(http: httpx.Client, page) -> httpx.Client:
-    """``http`` sending the page's id: the operator lease (docs/debugging.md) is held by the page whose
-    controls took it, so the test's own requests come from that page."""
-    http.headers["X-Fsmscope-Page"] = page.evaluate("async () => (await import('/api.js')).PAGE_ID")
-    return http
 
 
 @pytest.fixture(scope="module")
@@ -110,21 +99,6 @@ def menu_of(page, path: str):
     page.keyboard.press("Escape")
     page.click('.tree-row[data-path="%s"] .label' % path, button="right")
     return page.locator("#menu button")
-
-
-# The debugger banner's text, null while it is hidden.
-SHOWN_BANNER = """() => document.getElementById('debug-bar').hidden
-    ? null : document.querySelector('#debug-bar .debug-text').textContent"""
-
-
-def banner_saying(page, words: str = "", timeout: float = 8.0) -> str:
-    """The banner's text once it is shown saying ``words``; failing, what it said instead."""
-    def said() -> str | None:
-        text = page.evaluate(SHOWN_BANNER)
-        return text if text and words in text else None
-
-    return wait_for(said, timeout, interval=0.05,
-                    what=lambda: "the banner to say %r; it says %r" % (words, page.evaluate(SHOWN_BANNER)))
 
 
 # The badge of class `badge` drawn at the node of element id `id`: whether it is displayed and its
@@ -295,91 +269,3 @@ def test_looking_back_at_a_hold_shows_it_with_the_controls_disabled(rounds, brow
         assert not page.errors
     finally:
         page.close()
-
-
-# ---------------------------------------------------------------- the demo: a real `fsmscope demo`
-
-LIFT = "/SM_ROOT/TASK/PICK/LIFT"  # the arm rises with the cube: it moves the moment LIFT runs
-LIFT_BREAKPOINT = "hit breakpoint before TASK/PICK/LIFT when attempts >= 1"
-STILL = 1e-3  # rad (the fingers: m): the solver's noise in a held arm, far below what LIFT moves it
-
-
-@pytest.fixture(scope="module")
-def demo_page(browser, tmp_path_factory):
-    """The demo at real time (episodes of several seconds), watched by a page; ``page.http`` is an
-    operator's client, as that page."""
-    demo = DemoProcess(tmp_path_factory.mktemp("demo") / "demo.jsonl")
-    try:
-        page = open_page(browser, demo.url, 1600, 900, timeout_ms=30000)
-        page.wait_for_selector("#badge.live")
-        base = urllib.parse.urlsplit(demo.url)
-        page.http = as_page(httpx.Client(base_url="%s://%s" % (base.scheme, base.netloc), timeout=10,
-                                         headers={"Authorization": "Bearer " + demo.token}), page)
-        yield page
-        assert not page.errors
-        page.close()
-    finally:
-        assert demo.stop() == 130
-
-
-@pytest.fixture
-def demo(demo_page):
-    """The demo's page; its machine let go afterwards."""
-    yield demo_page
-    demo_page.keyboard.press("Escape")
-    demo_page.http.put("/api/machines/pick_place/breakpoints", json={"breakpoints": []})
-    demo_page.http.post("/api/machines/pick_place/resume")
-
-
-def joints(page) -> dict[str, float]:
-    """The arm's joints in the last pose the demo recorded (sim/pose.py: sampled at 30 Hz, sent when changed)."""
-    return page.evaluate("window.fsmscope.liveStatus.pose.joints")
-
-
-def moved(before: dict[str, float], after: dict[str, float]) -> float:
-    """How far the furthest joint moved between two poses."""
-    return max(abs(after[name] - position) for name, position in before.items())
-
-
-@pytest.mark.timeout(120)
-def test_on_the_demo_a_conditional_breakpoint_set_from_the_page_holds_the_arm_still_with_its_userdata_shown(demo):
-    demo.click('.tree-row[data-path="%s"] .label' % LIFT, button="right")
-    demo.locator("#menu button", has_text="Break when…").click()
-    demo.fill("#break-dialog input[name=when]", "attempts >= 1")
-    demo.click("#break-dialog button[value=send]")
-    demo.wait_for_selector("#break-dialog", state="hidden")
-    demo.wait_for_selector('.tree-row[data-path="%s"].breakpoint' % LIFT)
-    said = banner_saying(demo, LIFT_BREAKPOINT, timeout=60)
-    assert said == "Paused in /SM_ROOT/TASK/PICK: Holding before 'LIFT': " + LIFT_BREAKPOINT
-    time.sleep(0.5)  # the fingers' last squeeze
-    held = joints(demo)
-    time.sleep(2.0)  # LIFT, were it run, would be raising the arm by now
-    assert moved(held, joints(demo)) < STILL
-    demo.click('.tree-row[data-path="%s"] .label' % LIFT)  # its container's userdata
-    assert demo.input_value("#ud-container") == "/SM_ROOT/TASK/PICK"
-    attempts = demo.text_content('#userdata tr.ud-row[data-key="attempts"] td.value')
-    assert int(attempts) >= 1
-    assert '"held":true' in demo.text_content('#userdata tr.ud-row[data-key="grasp"] td.value')
-
-
-@pytest.mark.timeout(150)
-def test_on_the_demo_step_force_and_resume_drive_the_held_machine(demo):
-    demo.http.put("/api/machines/pick_place/breakpoints",
-                  json={"breakpoints": [{"state": LIFT, "at": "before", "when": "attempts >= 1"}]})
-    banner_saying(demo, LIFT_BREAKPOINT, timeout=60)
-    held = joints(demo)
-    demo.click("#step-btn")  # LIFT runs, raising the arm, and the machine holds as it returns
-    assert banner_saying(demo, "Holding after 'LIFT'", timeout=30).endswith(": stepped")
-    assert moved(held, joints(demo)) > 100 * STILL
-    demo.click("#force-btn")
-    demo.locator("#menu button", has_text="LIFT → aborted").click()  # as if the cube had slipped
-    pick = "window.fsmscope.liveStatus.containers['/SM_ROOT/TASK/PICK'].last"
-    demo.wait_for_function("() => %s.from === 'LIFT' && %s.to === 'REOPEN'" % (pick, pick))
-    assert demo.evaluate(pick + ".outcome") == "aborted"
-    demo.click('.tree-row[data-path="%s"] .label' % LIFT, button="right")
-    demo.locator("#menu button", has_text="Remove breakpoint").click()
-    demo.wait_for_selector('.tree-row[data-path="%s"]:not(.breakpoint)' % LIFT)
-    run = demo.evaluate("window.fsmscope.liveStatus.run")
-    demo.click("#resume-btn")
-    demo.wait_for_selector("#debug-bar", state="hidden")
-    demo.wait_for_function("run => window.fsmscope.liveStatus.run !== run", arg=run, timeout=60000)  # the episode ended

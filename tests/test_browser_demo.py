@@ -1,14 +1,13 @@
-"""The demo page as a user sees it: `fsmscope demo` as a real process, Debian's Chromium."""
+"""The demo page as a user sees it: `fsmscope demo` as a real process (shared with the demo's other
+tests), Debian's Chromium."""
 
 from __future__ import annotations
 
 import io
-import os
 
 import pytest
 from browser_support import ACTIVE_LEAF
-from server.testing.browser import CHROMIUM, launch_chromium, open_page
-from server.testing.demo_process import DemoProcess
+from server.testing.browser import open_page
 from server.testing.polling import wait_for
 
 # The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
@@ -19,23 +18,15 @@ def is_arm_orange(r: int, g: int, b: int) -> bool:
 
 
 @pytest.fixture(scope="module")
-def demo(tmp_path_factory):
-    if not os.path.exists(CHROMIUM):
-        pytest.skip("Debian's chromium is not installed (make apt)")
-    process = DemoProcess(tmp_path_factory.mktemp("demo") / "demo.jsonl")
-    yield process
-    assert process.stop() == 130  # interrupted, cleanly
-
-
-@pytest.fixture(scope="module")
-def page(demo):
-    playwright_api = pytest.importorskip("playwright.sync_api")
-    with playwright_api.sync_playwright() as pw:
-        browser = launch_chromium(pw)
-        page = open_page(browser, demo.url, 1600, 900, timeout_ms=20000)
+def page(browser, shared_demo):
+    """The shared demo, watched (its tests only look)."""
+    page = open_page(browser, shared_demo.process().url, 1600, 900, timeout_ms=20000)
+    try:
         page.wait_for_selector("#badge.live")
         yield page
-        browser.close()
+        assert not page.errors
+    finally:
+        page.close()
 
 
 @pytest.mark.timeout(90)

@@ -4,36 +4,39 @@ holds the loop (the server accepts it) and the page says so, not that it failed.
 
 from __future__ import annotations
 
-import os
-
 import pytest
-from server.testing.browser import CHROMIUM, launch_chromium, open_page
-from server.testing.demo_process import DemoProcess
+from browser_support import wait_for_a_fresh_episode as fresh_episode
+from server.testing.browser import open_page
+
+
+@pytest.fixture(scope="module")
+def watched(browser, shared_demo):
+    """The shared demo at real time (episodes of several seconds, a pause of 1 s between them), watched."""
+    page = open_page(browser, shared_demo.process().url, 1600, 900, timeout_ms=60000)
+    try:
+        page.wait_for_selector("#badge.live")
+        yield page
+        assert not page.errors
+    finally:
+        page.close()
 
 
 @pytest.fixture
-def demo_page(tmp_path):
-    """The demo at real time (episodes of several seconds, a pause of 1 s between them), watched."""
-    if not os.path.exists(CHROMIUM):
-        pytest.skip("Debian's chromium is not installed (make apt)")
-    playwright_api = pytest.importorskip("playwright.sync_api")
-    demo = DemoProcess(tmp_path / "demo.jsonl")
-    try:
-        with playwright_api.sync_playwright() as pw:
-            browser = launch_chromium(pw)
-            page = open_page(browser, demo.url, 1600, 900, timeout_ms=60000)
-            page.wait_for_selector("#badge.live")
-            page.wait_for_selector("#run-state.running")
-            yield page
-            assert not page.errors
-            browser.close()
-    finally:
-        demo.stop()
+def demo_page(watched, demo):
+    """The page, its demo running an episode, nobody in control and no notice shown (the demo let go
+    afterwards); ``page.demo`` is the process."""
+    watched.demo = demo
+    watched.wait_for_selector("#run-state.running")
+    # A page that lost the lease to the let-go says so: wait until it knows, then clear what it said.
+    watched.wait_for_function("() => document.getElementById('lease-state').textContent === 'nobody controls'")
+    watched.evaluate("async () => (await import('/notice.js')).clearNotice()")
+    yield watched
+    watched.keyboard.press("Escape")
 
 
 def wait_for_a_fresh_episode(page) -> None:
-    """Until the next episode has started: seconds of it ahead, for a control to land in."""
-    page.wait_for_selector("#run-state:not(.running)")
+    """Until an episode has just started, on the page too: seconds of it ahead, for a control to land in."""
+    fresh_episode(page.demo)
     page.wait_for_selector("#run-state.running")
 
 

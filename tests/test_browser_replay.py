@@ -2,13 +2,12 @@
 
 from __future__ import annotations
 
-import os
 import time
 
 import fsm
 import pytest
 from recording_support import replay_served
-from server.testing.browser import CHROMIUM, launch_chromium, open_page
+from server.testing.browser import open_page
 
 
 def record_abc(path) -> None:
@@ -29,8 +28,6 @@ def record_abc(path) -> None:
 
 @pytest.fixture
 def replay_url(tmp_path):
-    if not os.path.exists(CHROMIUM):
-        pytest.skip("Debian's chromium is not installed (make apt)")
     log = tmp_path / "abc.jsonl"
     record_abc(log)
     with replay_served(log) as (url, _):
@@ -38,15 +35,14 @@ def replay_url(tmp_path):
 
 
 @pytest.fixture
-def replay_page(replay_url):
+def replay_page(browser, replay_url):
     """The dashboard showing the replay, the whole log loaded before the URL was printed."""
-    playwright_api = pytest.importorskip("playwright.sync_api")
-    with playwright_api.sync_playwright() as pw:
-        browser = launch_chromium(pw)
-        page = open_page(browser, replay_url)
+    page = open_page(browser, replay_url)
+    try:
         yield page
         assert not page.errors
-        browser.close()
+    finally:
+        page.close()
 
 
 @pytest.mark.timeout(60)

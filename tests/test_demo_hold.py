@@ -1,24 +1,16 @@
 """The demo's episode loop keeps an operator's stop: a preempt pressed in the pause between two
 episodes holds the loop until Start (it used to be lost with a 409), and "stop after this
-episode" lets the running one finish first."""
+episode" lets the running one finish first. On the demo the tests share (tests/conftest.py: ``demo``,
+real time: episodes of several seconds with a pause of 1 s between them)."""
 
 from __future__ import annotations
 
 import time
 
 import pytest
+from browser_support import wait_for_a_fresh_episode
 
 from test_demo_process import api, wait_for_machine
-
-
-@pytest.fixture
-def demo(tmp_path):
-    """The demo at real time: episodes of several seconds with a pause of 1 s between them."""
-    from server.testing.demo_process import DemoProcess
-
-    demo = DemoProcess(tmp_path / "demo.jsonl")
-    yield demo
-    demo.stop()
 
 
 def runs_between(demo, seconds: float) -> int:
@@ -43,7 +35,8 @@ def test_a_preempt_between_episodes_holds_the_loop_until_start(demo):
 
 @pytest.mark.timeout(120)
 def test_stop_after_this_episode_lets_it_finish_then_waits_for_start(demo):
-    wait_for_machine(demo, lambda m: m["running"] and m["can_hold"])
+    wait_for_a_fresh_episode(demo)  # seconds of it ahead: the hold lands in it
+    assert wait_for_machine(demo, lambda m: m["running"])["can_hold"]
     status, _ = api(demo, "POST", "/api/machines/pick_place/hold", {"reason": "lunch"})
     assert status == 202 and wait_for_machine(demo, lambda m: True)["held"]
     finished = wait_for_machine(demo, lambda m: not m["running"])

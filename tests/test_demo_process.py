@@ -1,4 +1,5 @@
-"""`fsmscope demo` as a user runs it: a real process, stopped by a signal mid-episode."""
+"""`fsmscope demo` as a user runs it: a real process, stopped by a signal mid-episode (headless), and
+preempted and started again over REST (the demo the tests share, tests/conftest.py: ``demo``)."""
 
 from __future__ import annotations
 
@@ -11,7 +12,7 @@ import sys
 import time
 
 import pytest
-from browser_support import ROOT
+from browser_support import ROOT, wait_for_a_fresh_episode
 from server.testing.polling import wait_for
 
 FSMSCOPE = [sys.executable, "-m", "server.cli"]
@@ -62,19 +63,13 @@ def wait_for_machine(demo, predicate, timeout: float = 30.0) -> dict:
 
 
 @pytest.mark.timeout(120)
-def test_preempting_the_demo_halts_the_episode_and_start_runs_the_next(tmp_path):
-    from server.testing.demo_process import DemoProcess
-
-    demo = DemoProcess(tmp_path / "demo.jsonl")
-    try:
-        wait_for_machine(demo, lambda m: m["running"])
-        status, answer = api(demo, "POST", "/api/machines/pick_place/preempt", {"reason": "test"})
-        assert status == 202 and isinstance(answer["seq"], int)
-        stopped = wait_for_machine(demo, lambda m: not m["running"])
-        assert stopped["outcome"] == "preempted"
-        time.sleep(1.0)  # the loop waits for Start instead of going on by itself
-        assert not wait_for_machine(demo, lambda m: True)["running"]
-        assert api(demo, "POST", "/api/machines/pick_place/start", {})[0] == 202
-        wait_for_machine(demo, lambda m: m["running"])
-    finally:
-        assert demo.stop() == 130
+def test_preempting_the_demo_halts_the_episode_and_start_runs_the_next(demo):
+    wait_for_a_fresh_episode(demo)  # seconds of it ahead: the preempt lands in it
+    status, answer = api(demo, "POST", "/api/machines/pick_place/preempt", {"reason": "test"})
+    assert status == 202 and isinstance(answer["seq"], int)
+    stopped = wait_for_machine(demo, lambda m: not m["running"])
+    assert stopped["outcome"] == "preempted"
+    time.sleep(1.0)  # the loop waits for Start instead of going on by itself
+    assert not wait_for_machine(demo, lambda m: True)["running"]
+    assert api(demo, "POST", "/api/machines/pick_place/start", {})[0] == 202
+    wait_for_machine(demo, lambda m: m["running"])

@@ -109,10 +109,11 @@ def watch(browser, server, machine: str):
 
 
 @contextlib.contextmanager
-def watching(browser, server, machine: str, ready: str | None = None):
-    """A page showing ``machine`` of ``server`` with its stream live (and ``ready``, a selector, shown),
-    for one test; it must end without a script error, and is closed."""
-    page = watch(browser, server, machine)
+def page_at(browser, url: str, ready: str | None = None, width: int = 1280, height: int = 800,
+            timeout_ms: int = 15000):
+    """A page of ``browser`` at ``url`` showing a graph (and ``ready``, a selector, when given), for a
+    test or a module; it must end without a script error, and is closed."""
+    page = open_page(browser, url, width, height, timeout_ms)
     try:
         if ready is not None:
             page.wait_for_selector(ready)
@@ -120,6 +121,17 @@ def watching(browser, server, machine: str, ready: str | None = None):
         assert not page.errors
     finally:
         page.close()
+
+
+@contextlib.contextmanager
+def watching(browser, server, machine: str, ready: str | None = None):
+    """``watch``'s page (and ``ready``, a selector, shown) as ``page_at`` gives it: closed at the end,
+    which it must reach without a script error."""
+    with page_at(browser, server.url + "#m=" + urllib.parse.quote(machine), "#badge.live", timeout_ms=8000) as page:
+        assert page.input_value("#machine-picker") == machine
+        if ready is not None:
+            page.wait_for_selector(ready)
+        yield page
 
 
 def as_page(http: httpx.Client, page) -> httpx.Client:
@@ -313,6 +325,18 @@ class SharedDemo:
 
         wait_for(running_free, timeout, interval=0.1, what="the shared demo to run its episodes again")
         http.close()
+
+
+@contextlib.contextmanager
+def watching_demo(browser, shared_demo: SharedDemo, timeout_ms: int = 30000):
+    """A page watching the shared demo at 1600 x 900 (the 3D view beside the graph), its stream live;
+    at the end the demo is let go first (a page closed holding the lease would leave the deadman to
+    pause the machine for the next test), then the page, which must have had no script error, closed."""
+    with page_at(browser, shared_demo.process().url, "#badge.live", 1600, 900, timeout_ms) as page:
+        try:
+            yield page
+        finally:
+            shared_demo.let_go()
 
 
 def demo_client(demo: DemoProcess, page: str | None = None) -> httpx.Client:

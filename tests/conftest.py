@@ -117,6 +117,22 @@ def servers():
         server.shutdown(timeout=1.0)
 
 
+@pytest.fixture(scope="session")
+def headless_demo_log(tmp_path_factory):
+    """The log of one real-time episode of ``fsmscope demo --headless --episodes 1``, the arm's pose
+    recorded with it; recorded once for the modules that read it (none may write it)."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    path = tmp_path_factory.mktemp("headless-demo") / "demo.jsonl"
+    done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",
+                           "--record", str(path)], cwd=Path(__file__).resolve().parents[1],
+                          capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stdout + done.stderr
+    return path
+
+
 # The demo the tests share (browser_support.SharedDemo), made by the first test that needs it.
 _shared_demo: list = []
 

@@ -8,8 +8,7 @@ from __future__ import annotations
 import time
 
 import pytest
-from browser_support import DEMO_MACHINE, as_page, banner_saying, demo_client
-from server.testing.browser import open_page
+from browser_support import DEMO_MACHINE, as_page, banner_saying, demo_client, watching_demo
 
 LIFT = "/SM_ROOT/TASK/PICK/LIFT"  # the arm rises with the cube: it moves the moment LIFT runs
 WHEN = "attempts >= 1"
@@ -19,27 +18,20 @@ BREAKPOINTS = "/api/machines/%s/breakpoints" % DEMO_MACHINE
 
 
 @pytest.fixture(scope="module")
-def demo_page(browser, shared_demo):
+def watched(browser, shared_demo):
     """The shared demo at real time (episodes of several seconds), watched by a page; ``page.http``
-    is an operator's client, as that page. The demo is let go before the page closes (a page closed
-    with the lease would leave the deadman to pause the machine)."""
-    page = open_page(browser, shared_demo.process().url, 1600, 900, timeout_ms=30000)
-    try:
-        page.wait_for_selector("#badge.live")
+    is an operator's client, as that page."""
+    with watching_demo(browser, shared_demo) as page:
         page.http = as_page(demo_client(shared_demo.process()), page)
         yield page
-        assert not page.errors
-    finally:
-        shared_demo.let_go()
-        page.close()
 
 
 @pytest.fixture
-def page(demo_page):
+def page(watched):
     """The demo's page with no menu open afterwards. What the test leaves the demo doing stays for
-    the next one (``held`` takes a hold before LIFT over); ``demo_page`` lets the demo go at the end."""
-    yield demo_page
-    demo_page.keyboard.press("Escape")
+    the next one (``held`` takes a hold before LIFT over); ``watched`` lets the demo go at the end."""
+    yield watched
+    watched.keyboard.press("Escape")
 
 
 def held_before_lift(page) -> bool:

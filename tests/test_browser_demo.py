@@ -6,8 +6,7 @@ from __future__ import annotations
 import io
 
 import pytest
-from browser_support import ACTIVE_LEAF
-from server.testing.browser import open_page
+from browser_support import ACTIVE_LEAF, watching_demo
 from server.testing.polling import wait_for
 
 # The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
@@ -20,13 +19,8 @@ def is_arm_orange(r: int, g: int, b: int) -> bool:
 @pytest.fixture(scope="module")
 def page(browser, shared_demo):
     """The shared demo, watched (its tests only look)."""
-    page = open_page(browser, shared_demo.process().url, 1600, 900, timeout_ms=20000)
-    try:
-        page.wait_for_selector("#badge.live")
+    with watching_demo(browser, shared_demo, timeout_ms=20000) as page:
         yield page
-        assert not page.errors
-    finally:
-        page.close()
 
 
 @pytest.mark.timeout(90)

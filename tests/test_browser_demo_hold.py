@@ -5,20 +5,14 @@ holds the loop (the server accepts it) and the page says so, not that it failed.
 from __future__ import annotations
 
 import pytest
-from browser_support import wait_for_a_fresh_episode as fresh_episode
-from server.testing.browser import open_page
+from browser_support import watching_demo, wait_for_a_fresh_episode as fresh_episode
 
 
 @pytest.fixture(scope="module")
 def watched(browser, shared_demo):
     """The shared demo at real time (episodes of several seconds, a pause of 1 s between them), watched."""
-    page = open_page(browser, shared_demo.process().url, 1600, 900, timeout_ms=60000)
-    try:
-        page.wait_for_selector("#badge.live")
+    with watching_demo(browser, shared_demo, timeout_ms=60000) as page:
         yield page
-        assert not page.errors
-    finally:
-        page.close()
 
 
 @pytest.fixture

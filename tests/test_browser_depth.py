@@ -4,7 +4,7 @@ one container. A closed container is drawn as one node (s:PATH), an open one as 
 from __future__ import annotations
 
 import pytest
-from browser_support import watch
+from browser_support import watching
 from fsm.observation.schema import container_id, state_id
 from server.http_server import ServerThread
 from server_support import nested_machine
@@ -23,10 +23,8 @@ def served():
 
 @pytest.fixture
 def page(browser, served):
-    page = watch(browser, served, "nested")
-    yield page
-    assert not page.errors
-    page.close()
+    with watching(browser, served, "nested") as page:
+        yield page
 
 
 def drawn(page, element_id: str) -> None:

@@ -5,7 +5,7 @@ than 182 px; and the hierarchy follows the active state (static/tree.js)."""
 from __future__ import annotations
 
 import pytest
-from browser_support import serving_while_running, watch
+from browser_support import serving_while_running, watching
 from server.testing.big_machine import big_machine
 from server.testing.browser import open_page
 
@@ -19,10 +19,8 @@ def served():
 
 @pytest.fixture
 def page(browser, served):
-    page = watch(browser, served, "big")
-    yield page
-    assert not page.errors
-    page.close()
+    with watching(browser, served, "big") as page:
+        yield page
 
 
 def width(page, selector: str) -> float:

@@ -6,8 +6,8 @@ import time
 
 import fsm
 import pytest
+from browser_support import page_at
 from recording_support import replay_served
-from server.testing.browser import open_page
 
 
 def record_abc(path) -> None:
@@ -37,12 +37,8 @@ def replay_url(tmp_path):
 @pytest.fixture
 def replay_page(browser, replay_url):
     """The dashboard showing the replay, the whole log loaded before the URL was printed."""
-    page = open_page(browser, replay_url)
-    try:
+    with page_at(browser, replay_url) as page:
         yield page
-        assert not page.errors
-    finally:
-        page.close()
 
 
 @pytest.mark.timeout(60)

@@ -8,7 +8,7 @@ import json
 
 import fsm
 import pytest
-from browser_support import serving_while_running, watch
+from browser_support import serving_while_running, watching
 from fsm.observation.schema import container_id, state_id
 from server.testing.big_machine import big_machine, count_states
 from server.testing.polling import wait_for
@@ -29,11 +29,8 @@ def served():
 
 @pytest.fixture
 def page(browser, served):
-    page = watch(browser, served, "big")
-    page.wait_for_selector("#graph svg")
-    yield page
-    assert not page.errors
-    page.close()
+    with watching(browser, served, "big") as page:
+        yield page
 
 
 def search(page, text: str) -> None:

@@ -6,7 +6,7 @@ labels readable, the minimap (minimap.js)."""
 from __future__ import annotations
 
 import pytest
-from browser_support import serving_while_running, watch
+from browser_support import serving_while_running, watching
 from fsm.observation.schema import container_id
 from server.testing.big_machine import big_machine, count_states
 
@@ -46,11 +46,8 @@ def served():
 
 @pytest.fixture
 def page(browser, served):
-    page = watch(browser, served, "big")
-    page.wait_for_selector("#run-state.running")
-    yield page
-    assert not page.errors
-    page.close()
+    with watching(browser, served, "big", ready="#run-state.running") as page:
+        yield page
 
 
 def open_all(page) -> None:

@@ -5,15 +5,13 @@ machine looked back at while it runs."""
 
 from __future__ import annotations
 
-import subprocess
-import sys
 import threading
 import time
 import urllib.parse
 
 import fsm
 import pytest
-from browser_support import ROOT, served_page
+from browser_support import served_page
 from fsm.logfiles.log_reader import read_events, seek
 from server.cli import replay
 from server.http_server import ServerThread
@@ -26,25 +24,15 @@ STEPPED = ("start", "transition", "terminate")
 
 
 @pytest.fixture(scope="module")
-def demo_log(tmp_path_factory):
-    """One real-time headless demo episode, recorded with the arm's pose."""
-    path = tmp_path_factory.mktemp("demo") / "demo.jsonl"
-    done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",
-                           "--record", str(path)], cwd=ROOT, capture_output=True, text=True, timeout=240)
-    assert done.returncode == 0, done.stderr
-    return path
+def events(headless_demo_log):
+    return list(read_events(headless_demo_log))
 
 
 @pytest.fixture(scope="module")
-def events(demo_log):
-    return list(read_events(demo_log))
-
-
-@pytest.fixture(scope="module")
-def replayed(demo_log):
+def replayed(headless_demo_log):
     """The log loaded and served as `fsmscope replay --serve` does, with its pose-only 3D view."""
     hub = Hub()
-    assert replay.load(hub, replay.reader_of(str(demo_log)), 1.0) > 0
+    assert replay.load(hub, replay.reader_of(str(headless_demo_log)), 1.0) > 0
     scene = replay.pose_scene(hub)
     assert scene is not None, "the demo log recorded no pose"
     srv = ServerThread(hub=hub, scene_url=scene.url, show_pose=scene.show_pose).start()
@@ -76,8 +64,8 @@ def shown_status(page) -> dict:
     return page.evaluate("window.fsmscope.status.toDict()")
 
 
-def rebuilt(demo_log, seq) -> dict:
-    return seek(demo_log, MACHINE, seq).status.to_dict()
+def rebuilt(headless_demo_log, seq) -> dict:
+    return seek(headless_demo_log, MACHINE, seq).status.to_dict()
 
 
 def first_transition(events, path):
@@ -93,10 +81,10 @@ def test_a_replay_opens_paused_at_its_first_event(browser, replayed, events):
     page.close()
 
 
-def test_an_address_with_seq_shows_the_state_seek_rebuilds_at_that_event(browser, replayed, demo_log, events):
+def test_an_address_with_seq_shows_the_state_seek_rebuilds_at_that_event(browser, replayed, headless_demo_log, events):
     at = first_transition(events, "/SM_ROOT/TASK/PLACE")["seq"]
     page = open_at(browser, replayed[0], at)
-    shown, expected = shown_status(page), rebuilt(demo_log, at)
+    shown, expected = shown_status(page), rebuilt(headless_demo_log, at)
     assert active_paths(shown) == active_paths(expected) and "/SM_ROOT/TASK/PLACE/LOWER" in active_paths(shown)
     assert {p: c["userdata"] for p, c in shown["containers"].items()} == \
         {p: c["userdata"] for p, c in expected["containers"].items()}
@@ -128,7 +116,7 @@ def test_the_arm_is_drawn_where_the_log_put_it_at_the_instant(browser, replayed,
     page.close()
 
 
-def test_dragging_on_the_timeline_shows_the_state_at_the_instant_dragged_to(browser, replayed, demo_log, events):
+def test_dragging_on_the_timeline_shows_the_state_at_the_instant_dragged_to(browser, replayed, headless_demo_log, events):
     page = open_at(browser, replayed[0], events[0]["seq"])
     box = page.locator(".tl-canvas").bounding_box()
     left = box["x"] + page.evaluate("async () => (await import('/timeline_draw.js')).LAYOUT.labelW") + 5
@@ -140,21 +128,21 @@ def test_dragging_on_the_timeline_shows_the_state_at_the_instant_dragged_to(brow
     wait_for(lambda: page.evaluate("window.fsmscope.instant.seq") > events[30]["seq"], timeout=10,
              what="the drag to move the instant into the run")
     shown = shown_status(page)  # whatever instant the drag has reached: the state rebuilt there
-    assert active_paths(shown) == active_paths(rebuilt(demo_log, shown["last_seq"]))
+    assert active_paths(shown) == active_paths(rebuilt(headless_demo_log, shown["last_seq"]))
     page.close()
 
 
-def test_stepping_forward_and_back_crosses_a_nested_transition(browser, replayed, demo_log, events):
+def test_stepping_forward_and_back_crosses_a_nested_transition(browser, replayed, headless_demo_log, events):
     pick_ends = next(e for e in events if e["kind"] == "terminate" and e["path"] == "/SM_ROOT/TASK/PICK")
     after = next(e for e in events if e["seq"] > pick_ends["seq"] and e["kind"] in STEPPED)
     assert after["path"] == "/SM_ROOT/TASK"  # PICK ended, then TASK moves on: the next step is a level up
     page = open_at(browser, replayed[0], pick_ends["seq"])
     page.keyboard.press("ArrowRight")
     shown_at(page, after["seq"])
-    assert active_paths(shown_status(page)) == active_paths(rebuilt(demo_log, after["seq"]))
+    assert active_paths(shown_status(page)) == active_paths(rebuilt(headless_demo_log, after["seq"]))
     page.keyboard.press("ArrowLeft")
     shown_at(page, pick_ends["seq"])
-    assert active_paths(shown_status(page)) == active_paths(rebuilt(demo_log, pick_ends["seq"]))
+    assert active_paths(shown_status(page)) == active_paths(rebuilt(headless_demo_log, pick_ends["seq"]))
     page.close()
 
 
@@ -206,7 +194,7 @@ def test_the_instants_row_is_in_the_middle_of_the_event_log(browser, replayed, e
     page.close()
 
 
-def test_playing_moves_the_instant_forward_through_the_recorded_states(browser, replayed, demo_log, events):
+def test_playing_moves_the_instant_forward_through_the_recorded_states(browser, replayed, headless_demo_log, events):
     page = open_at(browser, replayed[0], events[0]["seq"])
     page.keyboard.press("Space")
     wait_for(lambda: page.evaluate("window.fsmscope.instant.seq") > events[20]["seq"], timeout=15,
@@ -214,7 +202,7 @@ def test_playing_moves_the_instant_forward_through_the_recorded_states(browser, 
     page.keyboard.press("Space")
     wait_for(lambda: not page.evaluate("window.fsmscope.instant.playing"), timeout=5, what="the pause")
     seq = page.evaluate("window.fsmscope.instant.seq")
-    assert active_paths(shown_status(page)) == active_paths(rebuilt(demo_log, seq))
+    assert active_paths(shown_status(page)) == active_paths(rebuilt(headless_demo_log, seq))
     page.close()
 
 

@@ -5,10 +5,7 @@ Real MuJoCo, real viser, a real `fsmscope demo` process and a real uvicorn.
 """
 
 import json
-import subprocess
-import sys
 import threading
-from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -22,7 +19,6 @@ from sim.pose import DEFAULT_RATE, PoseLayout, PoseTap
 from sim.scene import start_pose_scene, start_scene
 from sim.world import ARM_JOINTS, FINGER_JOINTS, HOME_Q, World
 
-ROOT = Path(__file__).resolve().parent.parent
 FLOAT32 = 1e-6  # viser keeps positions as float32
 # A world's xpos after mj_step is the kinematics of the step's starting qpos: it lags the recorded
 # qpos by one 2 ms step (under a millimetre for the arm moving fast), plus the recording's rounding.
@@ -51,13 +47,9 @@ def moving_world(seed: int = 0) -> World:
 
 
 @pytest.fixture(scope="module")
-def demo_log(tmp_path_factory) -> list[dict]:
+def demo_log(headless_demo_log) -> list[dict]:
     """The events of one headless demo episode, as `fsmscope demo --headless` records them."""
-    record = tmp_path_factory.mktemp("demo") / "demo.jsonl"
-    done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",
-                           "--record", str(record)], cwd=ROOT, capture_output=True, text=True, timeout=120)
-    assert done.returncode == 0, done.stdout + done.stderr
-    return [json.loads(line) for line in record.read_text().splitlines()]
+    return [json.loads(line) for line in headless_demo_log.read_text().splitlines()]
 
 
 @pytest.fixture

@@ -84,10 +84,11 @@ def live_server():
 TEST_CHROMIUM_ARGS = ["--enable-features=StrictOriginIsolation"]
 
 
-@pytest.fixture(scope="module")
-def browser():
-    """Debian's Chromium, shared by the tests of one module; skips when it, Playwright or Graphviz
-    (the server draws the graph with dot) is missing. Playwright is imported here, not at collection."""
+@pytest.fixture(scope="session")
+def chromium():
+    """Debian's Chromium, one process for the session (see ``browser``); skips when it, Playwright or
+    Graphviz (the server draws the graph with dot) is missing. Playwright is imported here, not at
+    collection."""
     from server.testing.browser import CHROMIUM, CHROMIUM_ARGS
 
     playwright_api = pytest.importorskip("playwright.sync_api")
@@ -97,9 +98,18 @@ def browser():
         pytest.skip("Graphviz's dot is not installed (make apt)")
     with playwright_api.sync_playwright() as pw:
         # server.testing.browser.launch_chromium, with TEST_CHROMIUM_ARGS (bench/ measures without them).
-        chromium = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS + TEST_CHROMIUM_ARGS, headless=True)
-        yield chromium
-        chromium.close()
+        launched = pw.chromium.launch(executable_path=CHROMIUM, args=CHROMIUM_ARGS + TEST_CHROMIUM_ARGS, headless=True)
+        yield launched
+        launched.close()
+
+
+@pytest.fixture(scope="module")
+def browser(chromium):
+    """Debian's Chromium for the tests of one module: every page it opens has a context of its own,
+    and whatever the module left open is closed at its end (one launch serves the whole session)."""
+    yield chromium
+    for context in chromium.contexts:
+        context.close()
 
 
 @pytest.fixture

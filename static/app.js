@@ -21,6 +21,7 @@ import { Minimap } from "./minimap.js";
 import { Panes } from "./panes.js";
 import { RunNotices, notice } from "./notice.js";
 import { EventLog } from "./eventlog.js";
+import { FramePace } from "./frame_pace.js";
 import { Playhead } from "./timetravel.js";
 import { Timeline } from "./timeline.js";
 import { TreeView } from "./tree.js";
@@ -183,11 +184,11 @@ function structureChanged() {
   if (!store.restructured()) return;
   const root = store.status.structure;
   graph.index(store.nodes.values());
+  depth.restructured();
+  loadGraph(); // asked first: the server lays it out while the hierarchy is built here
   tree.build(root);
   userdata.setContainers([...containers(root)]);
   if (!userdata.path || !store.nodes.has(userdata.path)) userdata.show(root ? root.path : null);
-  depth.restructured();
-  loadGraph();
 }
 
 /** Draw the layout of the structure with the containers `depth` opens (the server lays it out);
@@ -260,7 +261,7 @@ async function goTo(entry) {
   graph.follow = false;
   await depth.reveal(entry.path);
   select(entry.path);
-  graph.reveal(graph.stateElement(entry.path));
+  graph.centrePath(entry.path);
 }
 
 function stateMenu(path, x, y) {
@@ -273,7 +274,7 @@ function stateMenu(path, x, y) {
       userdata.show(node?.container ? path : parentPath(path));
       queueRender();
     } },
-    { label: "Center in graph", action: () => graph.reveal(graph.stateElement(path)) },
+    { label: "Center in graph", action: () => graph.centrePath(path) },
   ]);
 }
 
@@ -291,13 +292,15 @@ function updateBadge() {
   updateTopBar();
 }
 
-// Events, and a replay playing, are drawn at most 30 times a second, and at most 4 times a second
-// while the page looks back and only its count of events behind changes; the server is then asked
-// for the live events at that pace too (a frame every 250 ms rather than 50 a second): a flood
-// costs the page's computer (often the robot's) a fraction of a core (bench/live_rewind.py). What
-// the user does is drawn at the next frame.
+// Events, and a replay playing, are drawn at most 30 times a second, and no more often than leaves
+// drawing a quarter of the main thread (frame_pace.js: a big machine drawn open draws less often);
+// at most 4 times a second while the page looks back and only its count of events behind changes.
+// The server is then asked for the live events at that pace too (a frame every 250 ms rather than 50
+// a second): a flood costs the page's computer (often the robot's) a fraction of a core
+// (bench/live_rewind.py). What the user does is drawn at the next frame.
 const PACED_FRAME_MS = 33;
 const BEHIND_FRAME_MS = 250;
+const framePace = new FramePace();
 let lastRender = -Infinity;
 let renderTimer = null;
 
@@ -307,7 +310,7 @@ function queueRender(paced = false) {
   clearTimeout(renderTimer);
   renderTimer = null;
   renderQueued = true;
-  const pace = playhead.past && !playhead.playing ? BEHIND_FRAME_MS : PACED_FRAME_MS;
+  const pace = playhead.past && !playhead.playing ? BEHIND_FRAME_MS : framePace.gap(PACED_FRAME_MS);
   const wait = paced ? lastRender + pace - performance.now() : 0;
   if (wait <= 0) {
     requestAnimationFrame(render);
@@ -347,9 +350,13 @@ function updateLink() {
   }, 250);
 }
 
+// A drawing is two frames: the machine (graph, hierarchy, details, top bar), then the log and the
+// userdata. Each half of a big machine's drawing under a flood stays under 50 ms, where the whole
+// was a long task that kept the page from answering the user (bench/big_machine_browser.py).
 function render() {
   renderQueued = false;
   lastRender = performance.now();
+  framePace.started();
   if (!store.status) return;
   const s = shownStatus();
   const shown = view(s);
@@ -359,16 +366,23 @@ function render() {
   tree.update(s, shown.failed, marks);
   details.update();
   if (graph.follow && graph.activePath) tree.reveal(graph.activePath);
-  if (playhead.past && !playhead.window) log.freeze();
-  else log.showPast(playhead.past ? playhead.window : null);
-  log.flush();
   showInstant();
   scene.showPose(playhead.past ? s.pose : null);
   updateLink();
   machines.fillPicker();
-  const udPath = userdata.path;
-  userdata.update(s, udPath ? store.nodes.get(udPath) : null);
   updateTopBar();
+  requestAnimationFrame(renderPanels);
+}
+
+/** The second frame of a drawing: the log and the userdata of the instant shown. */
+function renderPanels() {
+  framePace.frame();
+  if (!store.status) return;
+  if (playhead.past && !playhead.window) log.freeze();
+  else log.showPast(playhead.past ? playhead.window : null);
+  log.flush();
+  const udPath = userdata.path;
+  userdata.update(shownStatus(), udPath ? store.nodes.get(udPath) : null);
 }
 
 // ---------------------------------------------------------------- go

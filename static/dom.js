@@ -14,3 +14,23 @@ export function h(tag, props = {}, ...children) {
   for (const child of children) if (child !== null && child !== undefined) el.append(child);
   return el;
 }
+
+/**
+ * Give `cls` to exactly the elements that `find` returns for `keys`, touching only those that
+ * change (a class set again is still a style recalculation, and a frame has many).
+ * @param {Set} before the keys marked so far (this function's last answer)
+ * @returns {Set} the keys marked now (those `find` found)
+ */
+export function markExactly(cls, before, keys, find) {
+  for (const key of before) {
+    if (!keys.has(key)) find(key)?.classList.remove(cls);
+  }
+  const now = new Set();
+  for (const key of keys) {
+    const el = find(key);
+    if (!el) continue;
+    if (!before.has(key)) el.classList.add(cls);
+    now.add(key);
+  }
+  return now;
+}

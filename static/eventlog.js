@@ -12,7 +12,10 @@ const MAX_ROWS = 800; // at least; up to MAX_ROWS + BLOCK_ROWS
 // block at a time (dropping rows one by one at the top moved and repainted every row at each frame),
 // and a block out of view is neither laid out nor painted (style.css).
 const BLOCK_ROWS = 100;
-const MAX_ROWS_PER_FRAME = 120; // under a flood only the newest rows of each frame are drawn
+// Under a flood only the newest rows of each frame are drawn (about what the pane shows), after a
+// line that says how many were not: a row costs the page about 0.4 ms of layout, and 120 a frame were
+// half of a 600-state machine's frame at 1,000 events/s (bench/big_machine_browser.py).
+const MAX_ROWS_PER_FRAME = 40;
 const HIDDEN_AT_FIRST = new Set(["pose"]); // 30 a second: shown only when asked for
 
 function selectionOf(ev) {
@@ -83,6 +86,7 @@ export class EventLog {
     this.events = [];
     this.shown = 0; // how many of this.events pass the filters
     this.pending = []; // events not drawn yet
+    this.undrawn = 0; // events the filters show that a flood left out of the rows since the last flush
     this.rowCount = 0; // rows drawn
     this.described = new WeakMap(); // event -> {line, text}: its transcript line and the text the filter searches
     this.needle = ""; // the text filter, lower case
@@ -163,7 +167,10 @@ export class EventLog {
     const dropped = this.events.length > MAX_EVENTS ? this.events.splice(0, this.events.length - MAX_EVENTS) : [];
     for (const ev of dropped) if (this._matches(ev)) this.shown -= 1;
     for (const ev of events) this.pending.push(ev);
-    if (this.pending.length > 4 * MAX_ROWS_PER_FRAME) this.pending.splice(0, this.pending.length - MAX_ROWS_PER_FRAME);
+    if (this.pending.length > 4 * MAX_ROWS_PER_FRAME) {
+      const left = this.pending.splice(0, this.pending.length - MAX_ROWS_PER_FRAME);
+      this.undrawn += left.filter((ev) => this._matches(ev)).length;
+    }
   }
 
   flush() {
@@ -171,7 +178,14 @@ export class EventLog {
     const events = this.pending;
     this.pending = [];
     const stick = this.stick;
-    const fresh = events.filter((ev) => this._matches(ev)).slice(-MAX_ROWS_PER_FRAME).map((ev) => this._row(ev));
+    const matching = events.filter((ev) => this._matches(ev));
+    const fresh = matching.slice(-MAX_ROWS_PER_FRAME).map((ev) => this._row(ev));
+    const undrawn = this.undrawn + matching.length - fresh.length;
+    this.undrawn = 0;
+    if (undrawn) {
+      fresh.unshift(h("div", { class: "log-gap",
+        text: `… ${undrawn} events not drawn: they came faster than the page draws (time travel has every one)` }));
+    }
     if (fresh.length) {
       this.host.querySelector(".empty")?.remove();
       this._append(fresh);

@@ -2,16 +2,20 @@
 // sanitized and inlined; status only toggles CSS classes on the stable ids of docs/api.md
 // (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
 // the layout never moves when only the status changes; the marks are drawn by an overlay of copies
-// (graph_marks.js), so the drawing itself never repaints. Pan (drag) and zoom (wheel) act on the
-// viewBox of both; a fit keeps labels readable (graph_geometry.js), a new layout of the same machine
+// (graph_marks.js), so the drawing itself never repaints. Both lie on a stage the size of the drawing
+// at the scale shown: a pan (drag, Follow) moves the stage (a CSS transform, which Chromium composites
+// without laying out or painting the drawing again: changing the viewBox of a 600-state drawing laid
+// its text out again, 15 ms a frame), a zoom resizes it. `vb`, the view box shown, is the one
+// abstraction the rest of the page reads. A fit keeps labels readable (graph_geometry.js), a new layout of the same machine
 // can keep one element where it was on screen (semantic zoom). It tells its host what changed
 // ("graph:layout", "graph:view", "graph:focus", "graph:fit" events), which the minimap and the
 // breadcrumb (minimap.js, breadcrumb.js) follow. One module (about 360 lines): loading, marking and pan/zoom all
 // act on the same inlined SVG and its element index.
 
 import { anchorAfter, anchorBefore, readableFit } from "./graph_fit.js";
-import { COMFORT_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox } from "./graph_geometry.js";
+import { COMFORT_SCALE, READABLE_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox, viewAt } from "./graph_geometry.js";
 import { GraphMarks } from "./graph_marks.js";
+import { markExactly } from "./dom.js";
 import { containerId, outcomeId, stateId } from "./schema.js";
 import { parentPath } from "./status.js";
 import { parseSvg } from "./svg_safe.js";
@@ -38,6 +42,14 @@ export class GraphView {
     this.clusters = []; // the open containers' frames in user space ({path, box}), parents first
     this.activePath = null; // the deepest active state
     this.selectedPath = null;
+    this.stage = null; // the element that holds the drawing and its marks, moved and sized by the view
+    this.stageScale = null; // px per SVG unit the stage is sized for
+    this.size = null; // the host's size in px, kept by a ResizeObserver (reading it would force a layout)
+    this.boxes = new Map(); // element id -> its box in user space (measured once per drawing)
+    new ResizeObserver(() => {
+      this.size = null;
+      if (this.vb) this._setViewBox(this.vb);
+    }).observe(host);
     this._bindPointer();
   }
 
@@ -66,6 +78,7 @@ export class GraphView {
     }
     svg.setAttribute("width", "100%");
     svg.setAttribute("height", "100%");
+    svg.setAttribute("viewBox", `${base.x} ${base.y} ${base.w} ${base.h}`);
     svg.setAttribute("preserveAspectRatio", "xMidYMid meet");
     svg.removeAttribute("style");
     svg.classList.add("graph-svg");
@@ -74,7 +87,12 @@ export class GraphView {
     this.base = base;
     this.key = key;
     this.classed = new Map();
-    this.host.replaceChildren(svg, this.marks.svg);
+    this.boxes = new Map();
+    this.stage = document.createElement("div");
+    this.stage.className = "graph-stage";
+    this.stageScale = null;
+    this.stage.append(svg, this.marks.svg);
+    this.host.replaceChildren(this.stage);
     this.clusters = clusterBoxes(svg, this.pathOf);
     const rect = this._hostSize();
     const anchored = anchor && rect ? anchorAfter(this, anchor, rect) : null;
@@ -87,6 +105,7 @@ export class GraphView {
   clear(message) {
     this.svg = null;
     this.marks = null;
+    this.stage = null;
     this.key = null;
     this.base = null;
     this.clusters = [];
@@ -130,18 +149,7 @@ export class GraphView {
 
   /** Set `cls` on exactly the elements whose ids are in `ids` (touching only what changed). */
   _setClass(cls, ids) {
-    const before = this.classed.get(cls) || new Set();
-    for (const id of before) {
-      if (!ids.has(id)) this.el(id)?.classList.remove(cls);
-    }
-    const now = new Set();
-    for (const id of ids) {
-      const el = this.el(id);
-      if (!el) continue;
-      el.classList.add(cls);
-      now.add(id);
-    }
-    this.classed.set(cls, now);
+    this.classed.set(cls, markExactly(cls, this.classed.get(cls) || new Set(), ids, (id) => this.el(id)));
   }
 
   /**
@@ -190,40 +198,63 @@ export class GraphView {
     return ids;
   }
 
-  /** Pan (never zoom) so that `el` is inside the view, when it is not already. */
-  reveal(el) {
-    const pan = this.svg && el ? this._panFor(el) : null;
-    if (pan) this._setViewBox(pan);
+  /** Centre the state at `path` (or its closest drawn ancestor), zoomed in to labels of a comfortable
+   * size when they are too small to read (a search's choice, "Center in graph"). */
+  centrePath(path) {
+    const el = this.stateElement(path);
+    const rect = this._hostSize();
+    if (!el || !rect || !this.vb) return;
+    const box = this._box(el);
+    const scale = this.scale() < READABLE_SCALE ? COMFORT_SCALE : this.scale();
+    this._setViewBox(viewAt(box.x + box.w / 2, box.y + box.h / 2, scale, rect.width, rect.height));
   }
 
-  /** The viewBox that brings `el` into the view, or null when it is in already (or cannot be). */
+  /** An element's box in user space, measured once per drawing. */
+  _box(el) {
+    let box = this.boxes.get(el.id);
+    if (!box) this.boxes.set(el.id, box = userBox(el, this.svg));
+    return box;
+  }
+
+  /** The viewBox that brings `el` into the view, or null when it is in already (or cannot be); from
+   * the drawing's geometry, so that following the active state reads no layout. */
   _panFor(el) {
-    const box = el.getBoundingClientRect();
-    const view = this.host.getBoundingClientRect();
-    if (!view.width || !view.height) return null;
-    const margin = 2;
-    if (box.width > view.width - 2 * margin || box.height > view.height - 2 * margin) return null;
-    const inside = box.left >= view.left + margin && box.right <= view.right - margin
-      && box.top >= view.top + margin && box.bottom <= view.bottom - margin;
+    const view = this.visible();
+    if (!view || !this.vb) return null;
+    const box = this._box(el);
+    const margin = 2 / this.scale();
+    if (box.w > view.w - 2 * margin || box.h > view.h - 2 * margin) return null;
+    const inside = box.x >= view.x + margin && box.x + box.w <= view.x + view.w - margin
+      && box.y >= view.y + margin && box.y + box.h <= view.y + view.h - margin;
     if (inside) return null;
-    const ctm = this.svg.getScreenCTM();
-    if (!ctm) return null;
-    const k = ctm.a || 1;
-    const dx = (box.left + box.width / 2 - (view.left + view.width / 2)) / k;
-    const dy = (box.top + box.height / 2 - (view.top + view.height / 2)) / k;
+    const dx = box.x + box.w / 2 - (view.x + view.w / 2);
+    const dy = box.y + box.h / 2 - (view.y + view.h / 2);
     return { ...this.vb, x: this.vb.x + dx, y: this.vb.y + dy };
   }
 
   /** The host's size in px, or null while it has none (hidden). */
   _hostSize() {
-    const rect = this.host.getBoundingClientRect();
-    return rect.width && rect.height ? rect : null;
+    if (!this.size) {
+      const rect = this.host.getBoundingClientRect();
+      if (rect.width && rect.height) this.size = { width: rect.width, height: rect.height };
+    }
+    return this.size;
   }
 
   /** Px per SVG unit of the view shown. */
   scale() {
     const rect = this._hostSize();
     return rect && this.vb ? Math.min(rect.width / this.vb.w, rect.height / this.vb.h) : 1;
+  }
+
+  /** What the host shows, in user space: `vb` widened to the host's proportions (it is shown centred,
+   * whole); null while the host has no size. */
+  visible() {
+    const rect = this._hostSize();
+    if (!rect || !this.vb) return null;
+    const k = this.scale();
+    const [w, h] = [rect.width / k, rect.height / k];
+    return { x: this.vb.x + (this.vb.w - w) / 2, y: this.vb.y + (this.vb.h - h) / 2, w, h };
   }
 
   /**
@@ -275,24 +306,32 @@ export class GraphView {
       clientX = rect.left + rect.width / 2;
       clientY = rect.top + rect.height / 2;
     }
-    const p = this._toUser(clientX, clientY);
+    const p = this._toUser(clientX - rect.left, clientY - rect.top);
     const w = Math.min(Math.max(this.vb.w / factor, this.base.w / 50, rect.width / 8), this.base.w * 20);
     const f = w / this.vb.w;
     this._setViewBox({ x: p.x - (p.x - this.vb.x) * f, y: p.y - (p.y - this.vb.y) * f, w, h: this.vb.h * f });
   }
 
-  _toUser(clientX, clientY) {
-    const ctm = this.svg.getScreenCTM();
-    const pt = new DOMPoint(clientX, clientY).matrixTransform(ctm ? ctm.inverse() : new DOMMatrix());
-    return { x: pt.x, y: pt.y };
+  /** The user-space point at (x, y) px from the host's top left. */
+  _toUser(x, y) {
+    const view = this.visible();
+    const k = this.scale();
+    return { x: view.x + x / k, y: view.y + y / k };
   }
 
+  /** Show `vb`: the stage resized when the scale changes (the drawing is painted again at it), else
+   * only moved. */
   _setViewBox(vb) {
     this.vb = vb;
-    if (!this.svg) return;
-    const text = `${vb.x} ${vb.y} ${vb.w} ${vb.h}`;
-    this.svg.setAttribute("viewBox", text);
-    this.marks.setViewBox(text);
+    const view = this.stage && this.visible();
+    if (!view) return;
+    const k = this.scale();
+    if (k !== this.stageScale) {
+      this.stageScale = k;
+      this.stage.style.width = `${this.base.w * k}px`;
+      this.stage.style.height = `${this.base.h * k}px`;
+    }
+    this.stage.style.transform = `translate(${(this.base.x - view.x) * k}px, ${(this.base.y - view.y) * k}px)`;
     this._emit("view");
   }
 
@@ -316,7 +355,7 @@ export class GraphView {
     }, { passive: false });
     host.addEventListener("pointerdown", (e) => {
       if (!this.svg || e.button !== 0) return;
-      drag = { x: e.clientX, y: e.clientY, vb: { ...this.vb }, k: this.svg.getScreenCTM()?.a || 1, moved: false };
+      drag = { x: e.clientX, y: e.clientY, vb: { ...this.vb }, k: this.scale(), moved: false };
     });
     host.addEventListener("pointermove", (e) => {
       if (!drag) return;

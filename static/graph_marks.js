@@ -1,7 +1,7 @@
 // The graph's marks (active, reached, last edge, failed, selected, breakpoint, held) drawn over the
 // drawing, so the drawing itself never repaints when the instant changes. The drawing's elements
 // keep their classes (the contract of docs/api.md: `#graph g.node.active` is the drawn state), but
-// no style reads them; each marked element gets a copy in an overlay <svg> with the same viewBox,
+// no style reads them; each marked element gets a copy in an overlay <svg> with the same viewBox (both fixed: graph.js moves them together),
 // placed by its ancestors' transforms, and only the copies are styled. Their classes are the
 // element's with "m-" in front, so no selector meant for the drawing ever matches a copy.
 //
@@ -56,7 +56,8 @@ export class GraphMarks {
     this.drawing = drawing;
     this.svg = document.createElementNS(SVG_NS, "svg");
     for (const [name, value] of [["class", "graph-marks"], ["aria-hidden", "true"], ["width", "100%"],
-      ["height", "100%"], ["preserveAspectRatio", drawing.getAttribute("preserveAspectRatio")]]) {
+      ["height", "100%"], ["viewBox", drawing.getAttribute("viewBox")],
+      ["preserveAspectRatio", drawing.getAttribute("preserveAspectRatio")]]) {
       this.svg.setAttribute(name, value);
     }
     this.layers = new Map(KINDS.map((kind) => [kind, this.svg.appendChild(document.createElementNS(SVG_NS, "g"))]));
@@ -77,10 +78,6 @@ export class GraphMarks {
       groups.set(frame, group);
     }
     return group;
-  }
-
-  setViewBox(text) {
-    this.svg.setAttribute("viewBox", text);
   }
 
   /** Draw a copy of exactly the elements whose ids are in `ids`, with their current classes; only

@@ -57,7 +57,8 @@ export class Minimap {
 
   /** The viewport's rectangle and the active state's dot. */
   _update() {
-    const { vb, svg, activePath } = this.graph;
+    const { svg, activePath } = this.graph;
+    const vb = this.graph.visible();
     if (!vb || !svg) return;
     for (const [name, value] of [["x", vb.x], ["y", vb.y], ["width", vb.w], ["height", vb.h]]) this.view.setAttribute(name, value);
     const el = activePath ? this.graph.stateElement(activePath) : null;

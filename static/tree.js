@@ -1,9 +1,10 @@
 // The side panel's tree of the hierarchy.
 // Every name, value and message goes in as text (createElement + textContent), never as HTML.
 
-import { h } from "./dom.js";
+import { h, markExactly } from "./dom.js";
 
-/** The tree of the hierarchy; rows are built once per structure, status only toggles classes. */
+/** The tree of the hierarchy; rows are built once per structure, status only toggles classes, on the
+ * rows whose marks change (per frame the work is O(active states), never O(states)). */
 export class TreeView {
   constructor(host, handlers) {
     this.host = host;
@@ -11,6 +12,13 @@ export class TreeView {
     this.rows = new Map(); // path -> row element
     this.collapsed = new Set();
     this.selected = null;
+    this.marked = new Map(); // class -> the paths whose rows have it
+    this.outcomes = new Map(); // container path -> the outcome its row shows
+    this.revealed = null; // the path last revealed, and its row while it is watched
+    this.revealedRow = null;
+    // Where the row to reveal is, read when the browser has laid it out anyway (asking at once would
+    // force a layout of the page in every frame that follows a new active state).
+    this.watcher = new IntersectionObserver((entries) => this._scrollTo(entries), { root: host, threshold: 1 });
     host.addEventListener("click", (e) => {
       const row = e.target.closest(".tree-row");
       if (!row) return;
@@ -31,7 +39,11 @@ export class TreeView {
 
   build(structure) {
     this.rows.clear();
+    this.marked = new Map();
+    this.outcomes = new Map();
+    this.watcher.disconnect();
     this.revealed = null;
+    this.revealedRow = null;
     if (!structure) {
       this.host.replaceChildren(h("p", { class: "empty", text: "No structure yet." }));
       return;
@@ -77,32 +89,42 @@ export class TreeView {
   update(status, failed, marks) {
     const active = new Set(status.activePaths());
     if (status.running && status.root_path) active.add(status.root_path);
-    const failedSet = new Set(failed);
-    const breakpoints = new Set(marks.breakpoints);
-    const held = new Set(marks.held);
-    for (const [path, row] of this.rows) {
-      row.classList.toggle("active", active.has(path));
-      row.classList.toggle("failed", failedSet.has(path));
-      row.classList.toggle("breakpoint", breakpoints.has(path));
-      row.classList.toggle("held", held.has(path));
-      const entry = status.containers[path];
-      const out = row.lastElementChild;
-      const text = entry && !entry.running && entry.outcome ? "→ " + entry.outcome : "";
-      if (out.textContent !== text) out.textContent = text;
+    const find = (path) => this.rows.get(path);
+    for (const [cls, paths] of [["active", active], ["failed", new Set(failed)],
+      ["breakpoint", new Set(marks.breakpoints)], ["held", new Set(marks.held)]]) {
+      this.marked.set(cls, markExactly(cls, this.marked.get(cls) || new Set(), paths, find));
     }
+    const outcomes = new Map();
+    for (const [path, entry] of Object.entries(status.containers)) {
+      if (!entry.running && entry.outcome) outcomes.set(path, "→ " + entry.outcome);
+    }
+    for (const path of new Set([...this.outcomes.keys(), ...outcomes.keys()])) {
+      const out = this.rows.get(path)?.lastElementChild;
+      const text = outcomes.get(path) ?? "";
+      if (out && out.textContent !== text) out.textContent = text;
+    }
+    this.outcomes = outcomes;
   }
 
-  /** Scroll the row of `path` into the middle of the tree when it is out of view (Follow active);
-   * a collapsed branch stays collapsed. */
+  /** Scroll the row of `path` into the middle of the tree when it is out of view (Follow active),
+   * once, when the browser next lays it out; a collapsed branch stays collapsed. */
   reveal(path) {
     if (path === this.revealed) return;
     this.revealed = path;
-    const row = this.rows.get(path);
-    if (!row || !row.offsetParent) return;
-    const box = row.getBoundingClientRect();
-    const view = this.host.getBoundingClientRect();
-    if (box.top >= view.top && box.bottom <= view.bottom) return;
-    this.host.scrollTop += box.top - view.top - (view.height - box.height) / 2;
+    if (this.revealedRow) this.watcher.unobserve(this.revealedRow);
+    this.revealedRow = this.rows.get(path) ?? null;
+    if (this.revealedRow) this.watcher.observe(this.revealedRow);
+  }
+
+  _scrollTo(entries) {
+    for (const { target, boundingClientRect: box, rootBounds: view, intersectionRatio } of entries) {
+      if (target !== this.revealedRow) continue;
+      this.watcher.unobserve(target); // revealed once: the user may scroll away from it
+      this.revealedRow = null;
+      // A row in a collapsed branch has no box; one wholly in view needs no scroll.
+      if (!box.height || !view || intersectionRatio >= 1) continue;
+      this.host.scrollTop += box.top - view.top - (view.height - box.height) / 2;
+    }
   }
 
   select(path) {

@@ -44,6 +44,7 @@ DATA_ID = "fsmscope-export"
 _IMPORT = re.compile(r"""(\b(?:from|import)\s*)(["'])(\.\.?/[^"']+)\2""")
 _STYLESHEET = re.compile(r'<link rel="stylesheet" href="([^"]+)">')
 _MODULE = re.compile(r'<script type="module" src="([^"]+)"></script>')
+_PRELOAD = re.compile(r'<link rel="modulepreload" href="[^"]+">\n')  # the export embeds every module
 
 
 class ExportError(Exception):
@@ -187,6 +188,7 @@ def page(data: dict, title: str) -> str:
     text = _substitute(_STYLESHEET, inline_style, read("index.html"), "stylesheet link")
     styles.append(read(OFFLINE_STYLE))
     text = text.replace("</head>", "<style>%s</style>\n</head>" % styles[-1], 1)
+    text = _PRELOAD.sub("", text)
     module = _MODULE.search(text)
     if module is None:
         raise ExportError("static/index.html has no module script")

@@ -63,8 +63,8 @@ export class GraphView {
    *   screen, at the same scale; null: fit the new drawing
    */
   async load(key, fetchSvg, anchorPath = null) {
+    const token = ++this.loadToken; // any later request, even for the drawing shown, outdates one in flight
     if (key === this.key) return false;
-    const token = ++this.loadToken;
     const text = await fetchSvg();
     if (token !== this.loadToken) return false; // a newer load started meanwhile
     const svg = parseSvg(text);

@@ -70,7 +70,14 @@ def test_choosing_a_deep_state_opens_the_containers_on_its_path(page):
 def test_choosing_a_deep_state_brings_it_into_view(page):
     choose(page, DEEP_LABEL)
     page.wait_for_selector('#graph [id="%s"]' % state_id(DEEP), state="attached")
-    wait_for(lambda: in_view(page, state_id(DEEP)), timeout=10, what="the chosen state in view")
+    wait_for(lambda: in_view(page, state_id(DEEP)), timeout=10, what=lambda: "the chosen state in view; " + page.evaluate(
+        """(id) => {
+          const el = document.getElementById(id), view = document.getElementById('graph').getBoundingClientRect();
+          const b = el && el.getBoundingClientRect();
+          return JSON.stringify({ drawn: Boolean(el), box: b && [b.left, b.top, b.right, b.bottom],
+            graph: [view.left, view.top, view.right, view.bottom], selected: window.fsmscope.selected,
+            follow: document.getElementById('follow').checked, depth: document.getElementById('depth').value });
+        }""", state_id(DEEP)))
 
 
 def test_choosing_a_state_selects_it(page):

@@ -20,7 +20,9 @@ export class Depth {
     this.drawnOpen = drawnOpen;
     this.changed = changed;
     this.expand = null; // null: "auto"; else a Set of container paths drawn open
-    this.semantic = new SemanticZoom(() => changed(true));
+    // A re-layout semantic zoom had scheduled is dropped once the user has chosen what is open: it would
+    // replace the drawing the user asked for (a search's choice) with one anchored elsewhere.
+    this.semantic = new SemanticZoom(() => (this.expand ? Promise.resolve() : changed(true)));
     this.semanticOn = false; // "auto" is semantic zoom: the server's default left containers closed
     select.addEventListener("change", () => this._chosen(select.value));
   }

@@ -40,6 +40,7 @@ let stream = null; // the stream of the machine shown
 let renderQueued = false;
 const KEY_HISTORY_LIMIT = 10000; // events of a run read for one key's history
 const TIMELINE_REFRESH_MS = 1000; // a live machine's timeline is asked again this often
+const TREE_WAIT_MS = 250; // the hierarchy's rows wait this long at most for the drawing
 let timelineRange = { since_t: null, until_t: null }; // the range the timeline shows (null: the whole run)
 
 const playhead = new Playhead(api, {
@@ -185,8 +186,14 @@ function structureChanged() {
   const root = store.status.structure;
   graph.index(store.nodes.values());
   depth.restructured();
-  loadGraph(); // asked first: the server lays it out while the hierarchy is built here
-  tree.build(root);
+  // The drawing first: a big machine's hierarchy takes longer to build and lay out than the server's
+  // drawing takes to come, so its rows wait for the drawing (at most TREE_WAIT_MS).
+  const drawn = loadGraph();
+  Promise.race([drawn, new Promise((done) => setTimeout(done, TREE_WAIT_MS))]).then(() => {
+    if (store.status?.structure !== root) return; // another machine or structure since
+    tree.build(root);
+    queueRender();
+  });
   userdata.setContainers([...containers(root)]);
   if (!userdata.path || !store.nodes.has(userdata.path)) userdata.show(root ? root.path : null);
 }

@@ -228,7 +228,10 @@ export class EventLog {
     this._show(rows, "No events.");
     this._count();
     this.stick = true;
-    this.host.scrollTop = this.host.scrollHeight;
+    // To the newest row when the page is next laid out anyway (now would lay it all out once more).
+    requestAnimationFrame(() => {
+      if (this.stick && !this.past) this.host.scrollTop = this.host.scrollHeight;
+    });
   }
 
   _drawPast() {

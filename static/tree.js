@@ -51,6 +51,7 @@ export class TreeView {
     const ul = h("ul", { class: "tree", role: "tree" });
     ul.append(this._node(structure, 0));
     this.host.replaceChildren(ul);
+    if (this.selected) this.rows.get(this.selected)?.classList.add("selected");
   }
 
   _node(node, depth) {

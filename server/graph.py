@@ -9,7 +9,8 @@ docs/api.md: ``s:PATH`` (state), ``o:PATH:OUTCOME`` (container outcome),
 ``e:PATH:FROM:OUTCOME`` (edge), ``c:PATH`` (open container).
 
 Results are cached per (structure hash, set of open containers); a composed container is
-also cached on its own, so opening one more container lays out only it and its ancestors.
+also cached on its own, serialized, so opening one more container lays out and serializes only it
+and its ancestors (the document is the cached pieces joined).
 """
 
 from __future__ import annotations
@@ -37,6 +38,13 @@ _G = "{%s}g" % SVG_NS
 _POLYGON = "{%s}polygon" % SVG_NS
 _TITLE = "{%s}title" % SVG_NS
 _PAGE = re.compile(r"^page\d+,\d+_(?=[scoe]:)")  # dot's prefix of ids when it paginates (static/graph.js drops it too)
+_HOLE = re.compile(rb"<!--fsmscope-child-(\d+)-->")  # where an open child's drawing goes in its parent's text
+# A piece's own declarations: the document's root declares them once. Only these two: dot writes no other.
+_DECLARATIONS = re.compile(rb' xmlns(?::xlink)?="(?:%s|%s)"' % (SVG_NS.encode(), XLINK_NS.encode()))
+
+# A composed container: its serialized drawing as text pieces and, between them, the path of the open
+# child whose drawing goes there; its width and height in points.
+Part = tuple[list[bytes | str], float, float]
 
 AUTO_OPEN_LIMIT = 150   # without ``expand``: every container open up to this many states, else only the root
 DOT_TIMEOUT = 60.0
@@ -210,7 +218,7 @@ class Renderer:
     def __init__(self, max_docs: int = 64, max_parts: int = 4096) -> None:
         self._lock = threading.Lock()
         self._docs: collections.OrderedDict[tuple, bytes] = collections.OrderedDict()
-        self._parts: collections.OrderedDict[tuple, tuple[ET.Element, float, float]] = collections.OrderedDict()
+        self._parts: collections.OrderedDict[tuple, Part] = collections.OrderedDict()
         self._max_docs = max_docs
         self._max_parts = max_parts
         self.layouts = 0  # containers laid out by dot so far (for tests and benchmarks)
@@ -240,7 +248,7 @@ class Renderer:
         for node, depth in structure.walk(root, lambda c: c["path"] in opened):
             if node["path"] in opened:
                 by_depth[depth].append(node)
-        done: dict[str, tuple[ET.Element, float, float]] = {}
+        done: dict[str, Part] = {}
         for depth in sorted(by_depth, reverse=True):
             todo = []
             for node in by_depth[depth]:
@@ -265,16 +273,20 @@ class Renderer:
                 self._parts[pkey] = part
             while len(self._parts) > self._max_parts:
                 self._parts.popitem(last=False)
-        group, w, h = done[root["path"]]
+        _, w, h = done[root["path"]]
         svg = ET.Element("{%s}svg" % SVG_NS, {"width": "%gpt" % w, "height": "%gpt" % h,
                                                "viewBox": "0 0 %g %g" % (w, h), "class": "fsm-graph"})
-        svg.append(group)
-        return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(svg)
+        svg.append(ET.Comment("fsmscope-child-0"))
+        head, _, tail = ET.tostring(svg).partition(b"<!--fsmscope-child-0-->")
+        out = [b'<?xml version="1.0" encoding="UTF-8"?>\n', head.replace(b"<svg ", b'<svg xmlns:xlink="%s" ' % XLINK_NS.encode(), 1)]
+        _join(root["path"], done, out)
+        out.append(tail)
+        return b"".join(out)
 
     @staticmethod
-    def _compose(node: dict, svg: ET.Element, done: dict, titles: dict[str, str]) -> tuple[ET.Element, float, float]:
-        """The container's drawing, its elements titled by ``titles``, with each open child's drawing put
-        in its placeholder's place."""
+    def _compose(node: dict, svg: ET.Element, done: dict[str, Part], titles: dict[str, str]) -> Part:
+        """The container's drawing, its elements titled by ``titles``, with a hole in each open child's
+        placeholder, serialized."""
         group = svg.find(_G)
         if group is None:
             raise GraphError("dot produced no graph for %s" % node["path"])
@@ -289,6 +301,7 @@ class Renderer:
             frame.set("class", "frame")
             frame.set("stroke", "#999999")
         placeholders = {state_id(c["path"]): c["path"] for c in node.get("children") or () if c["path"] in done}
+        holes: list[str] = []
         for i, child in enumerate(list(group)):
             cpath = placeholders.get(child.get("id", ""))
             if child.tag != _G or cpath is None:
@@ -296,12 +309,26 @@ class Renderer:
             corner = _bbox(child)
             if corner is None:
                 continue
-            inner = done[cpath][0]
             wrapper = ET.Element(_G, {"transform": "translate(%g %g)" % corner})
-            wrapper.append(inner)
+            wrapper.append(ET.Comment("fsmscope-child-%d" % len(holes)))
+            holes.append(cpath)
             group[i] = wrapper
+        text = ET.tostring(group)
+        start = text.index(b">")
+        pieces: list[bytes | str] = _HOLE.split(_DECLARATIONS.sub(b"", text[:start]) + text[start:])
+        for i in range(1, len(pieces), 2):
+            pieces[i] = holes[int(pieces[i])]
         w, h = _size(svg)
-        return group, w, h
+        return pieces, w, h
+
+
+def _join(path: str, done: dict[str, Part], out: list[bytes]) -> None:
+    """Append the text of the drawing of ``path``, its open children's drawings in their holes."""
+    for i, piece in enumerate(done[path][0]):
+        if i % 2:
+            _join(piece, done, out)  # type: ignore[arg-type]
+        else:
+            out.append(piece)  # type: ignore[arg-type]
 
 
 _default = Renderer()

@@ -94,8 +94,7 @@ export class GraphView {
     this.stage.append(svg, this.marks.svg);
     this.host.replaceChildren(this.stage);
     this.clusters = clusterBoxes(svg, this.pathOf);
-    const rect = this._hostSize();
-    const anchored = anchor && rect ? anchorAfter(this, anchor, rect) : null;
+    const anchored = anchor ? anchorAfter(this, anchor) : null;
     if (anchored) this._setViewBox(anchored);
     else this.fit();
     this._emit("layout");

@@ -51,31 +51,37 @@ export function readableFit(g, rect) {
     note: `Fit shows ${nameOf(g.pathOf.get(el.id) ?? focus)}: ${tiny}` };
 }
 
-/** Where the elements standing for `path` and its ancestors are on screen before a re-layout: a node
- * by its centre, an open container by its top left corner (it grows right and down when a child
- * opens); null when none is drawn. */
+/** Where the elements standing for `path` and its ancestors are in the view before a re-layout: a
+ * node by its centre, an open container by its top left corner (it grows right and down when a child
+ * opens), in user space with the view box shown; null when none is drawn. Read from the drawing's
+ * attributes: no layout. */
 export function anchorBefore(g, path) {
+  if (!g.vb) return null;
   const spots = [];
   for (let p = path; p; p = parentPath(p)) {
     for (const id of [stateId(p), containerId(p)]) {
       const el = g.el(id);
-      if (!el) continue;
-      const r = el.getBoundingClientRect();
       const cluster = id !== stateId(p);
-      spots.push({ id, cluster, x: cluster ? r.left : r.left + r.width / 2, y: cluster ? r.top : r.top + r.height / 2 });
+      if (el) spots.push({ id, cluster, at: anchorPoint(el, g.svg, cluster) });
     }
   }
-  return spots.length ? { spots, scale: g.scale() } : null;
+  return spots.length ? { spots, vb: { ...g.vb } } : null;
 }
 
 /** The view box of the new drawing, at the old scale, that puts the first of the anchor's elements it
- * still has where it was on screen; null when it has none of them. */
-export function anchorAfter(g, { spots, scale }, rect) {
-  const spot = spots.find((s) => g.el(s.id));
-  if (!spot) return null;
-  const base = g.base;
-  g._setViewBox(viewAt(base.x + base.w / 2, base.y + base.h / 2, scale, rect.width, rect.height));
-  const r = g.el(spot.id).getBoundingClientRect();
-  const [x, y] = spot.cluster ? [r.left, r.top] : [r.left + r.width / 2, r.top + r.height / 2];
-  return { ...g.vb, x: g.vb.x + (x - spot.x) / scale, y: g.vb.y + (y - spot.y) / scale };
+ * still has where it was in the view; null when it has none of them. */
+export function anchorAfter(g, { spots, vb }) {
+  for (const { id, cluster, at } of spots) {
+    const el = g.el(id);
+    if (!el) continue;
+    const now = anchorPoint(el, g.svg, cluster);
+    return { ...vb, x: vb.x + now.x - at.x, y: vb.y + now.y - at.y };
+  }
+  return null;
+}
+
+/** A node's centre, or an open container's top left corner, in user space. */
+function anchorPoint(el, svg, cluster) {
+  const box = userBox(el, svg);
+  return cluster ? { x: box.x, y: box.y } : { x: box.x + box.w / 2, y: box.y + box.h / 2 };
 }

@@ -35,10 +35,40 @@ function boxOf(points, matrix) {
   return { x: x0, y: y0, w: x1 - x0, h: y1 - y0 };
 }
 
-/** An element's box in the user space of `root` (getBBox: measured once, by the caller's choice). */
+/** The points that outline an element's own shapes (its polygons, ellipses and paths: what Graphviz
+ * draws a node or a frame with), in its coordinates, read from their attributes. */
+function outline(el) {
+  const points = [];
+  for (const shape of el.querySelectorAll(":scope > polygon, :scope > ellipse, :scope > path")) {
+    if (shape.localName === "polygon") {
+      for (const p of shape.points) points.push(new DOMPoint(p.x, p.y));
+    } else if (shape.localName === "ellipse") {
+      const [cx, cy, rx, ry] = ["cx", "cy", "rx", "ry"].map((a) => shape[a].baseVal.value);
+      points.push(new DOMPoint(cx - rx, cy - ry), new DOMPoint(cx + rx, cy + ry));
+    } else {
+      // dot's paths are absolute "M x,y C x,y x,y x,y ...": their control points bound the curve
+      const n = (shape.getAttribute("d") || "").match(/-?(?:\d+\.?\d*|\.\d+)(?:e[-+]?\d+)?/gi) || [];
+      for (let i = 0; i + 1 < n.length; i += 2) points.push(new DOMPoint(Number(n[i]), Number(n[i + 1])));
+    }
+  }
+  return points;
+}
+
+/** An element's box in its own coordinates: from its shapes' attributes, so that asking forces no
+ * layout (getBBox, which does, only for an element drawn without any). */
+export function ownBox(el) {
+  const points = outline(el);
+  if (!points.length) {
+    const b = el.getBBox();
+    return { x: b.x, y: b.y, w: b.width, h: b.height };
+  }
+  return boxOf(points, new DOMMatrix());
+}
+
+/** An element's box in the user space of `root` (no layout: `ownBox`). */
 export function userBox(el, root) {
-  const b = el.getBBox();
-  const corners = [[b.x, b.y], [b.x + b.width, b.y], [b.x, b.y + b.height], [b.x + b.width, b.y + b.height]];
+  const b = ownBox(el);
+  const corners = [[b.x, b.y], [b.x + b.w, b.y], [b.x, b.y + b.h], [b.x + b.w, b.y + b.h]];
   return boxOf(corners.map(([x, y]) => new DOMPoint(x, y)), placement(el, root));
 }
 

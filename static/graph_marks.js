@@ -9,7 +9,7 @@
 // 606 states (1,400 elements) that was 15 ms of every frame (bench/timetravel_browser.py), and
 // the overlay holds a few elements.
 
-import { placement } from "./graph_geometry.js";
+import { ownBox, placement } from "./graph_geometry.js";
 
 const SVG_NS = "http://www.w3.org/2000/svg";
 const KINDS = ["cluster", "edge", "node"]; // the overlay's layers, drawn in this order
@@ -37,12 +37,12 @@ function svgElement(name, attributes) {
 
 /** The badges of the drawing's element `el`, in its own coordinates (measured once per element). */
 function badges(el) {
-  const box = el.getBBox();
-  const r = Math.max(3, Math.min(6, box.height / 4));
+  const box = ownBox(el);
+  const r = Math.max(3, Math.min(6, box.h / 4));
   const group = svgElement("g", { class: "badges" });
   group.append(svgElement("circle", { class: "bp-badge", cx: box.x + r / 2, cy: box.y + r / 2, r }));
   const held = svgElement("g", { class: "held-badge" });
-  const [x, y] = [box.x + box.width - r / 2, box.y + r / 2];
+  const [x, y] = [box.x + box.w - r / 2, box.y + r / 2];
   held.append(svgElement("circle", { cx: x, cy: y, r: r * 1.2 }),
     svgElement("rect", { x: x - r * 0.5, y: y - r * 0.6, width: r * 0.35, height: r * 1.2 }),
     svgElement("rect", { x: x + r * 0.15, y: y - r * 0.6, width: r * 0.35, height: r * 1.2 }));

@@ -1,8 +1,8 @@
 // The minimap: the whole drawing's outline (its open containers' frames, drawn once per layout), the
 // rectangle the graph pane shows and a dot on the active state; a click or a drag on it pans there.
 // It follows the GraphView's events (graph.js), redrawn at most once per animation frame, and reads
-// the active state's box once per element and layout (getBBox), so following a fast machine costs a
-// few attribute writes a frame.
+// the active state's box once per element and layout (from the drawing's attributes), so following a
+// fast machine costs a few attribute writes a frame.
 
 import { userBox } from "./graph_geometry.js";
 

@@ -4,9 +4,9 @@ Laying out a whole hierarchy as one graph explodes (1,000 states took minutes); 
 open container is a graph of its own in which a child container is one node: a plain box
 when closed, a fixed-size box the size of the child's finished drawing when open. The
 child's drawing is then put in that box's place. Graphs are built with pydot's API (never
-by parsing DOT); all containers of one depth go to one ``dot`` process. Ids follow
-docs/api.md: ``s:PATH`` (state), ``o:PATH:OUTCOME`` (container outcome),
-``e:PATH:FROM:OUTCOME`` (edge), ``c:PATH`` (open container).
+by parsing DOT); the containers of one depth are laid out at once by the kept ``dot``
+processes (server/dot.py). Ids follow docs/api.md: ``s:PATH`` (state), ``o:PATH:OUTCOME``
+(container outcome), ``e:PATH:FROM:OUTCOME`` (edge), ``c:PATH`` (open container).
 
 Results are cached per (structure hash, set of open containers); a composed container is
 also cached on its own, serialized, so opening one more container lays out and serializes only it
@@ -19,8 +19,6 @@ import collections
 import concurrent.futures
 import os
 import re
-import shutil
-import subprocess
 import threading
 import xml.etree.ElementTree as ET
 from typing import Iterable
@@ -29,6 +27,8 @@ import pydot
 
 from fsm.observation import structure
 from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
+
+from .dot import DotError, DotPool
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -163,27 +163,21 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
     return g, titles
 
 
+_dot = DotPool(min(os.cpu_count() or 1, 8))
+
+
 def run_dot(graphs: list[pydot.Dot]) -> list[ET.Element]:
     """Lay out several graphs with one dot process; returns each one's <svg> element, in order."""
-    dot = shutil.which("dot")
-    if dot is None:
-        raise GraphError("Graphviz 'dot' is not installed")
-    text = "\n".join(g.to_string() for g in graphs).encode()
     try:
-        proc = subprocess.run([dot, "-Tsvg"], input=text, capture_output=True, timeout=DOT_TIMEOUT)
-    except subprocess.TimeoutExpired as exc:
-        raise GraphError("dot took longer than %.0f s" % DOT_TIMEOUT) from exc
-    if proc.returncode != 0:
-        raise GraphError("dot failed: %s" % proc.stderr.decode(errors="replace")[:500])
-    docs = proc.stdout.split(b"<?xml")[1:]
-    if len(docs) != len(graphs):
-        raise GraphError("dot returned %d drawings for %d graphs" % (len(docs), len(graphs)))
-    return [ET.fromstring(b"<?xml" + doc) for doc in docs]
+        docs = _dot.layout([g.to_string().encode() for g in graphs], DOT_TIMEOUT)
+    except DotError as exc:
+        raise GraphError(str(exc)) from exc
+    return [ET.fromstring(doc) for doc in docs]
 
 
 def run_dot_parallel(graphs: list[pydot.Dot]) -> list[ET.Element]:
-    """``run_dot`` split over one dot process per core when there are many graphs."""
-    workers = min(os.cpu_count() or 1, 8, max(1, len(graphs) // 8))
+    """``run_dot`` split over the kept dot processes (one per core): containers of one depth at once."""
+    workers = min(_dot.size, len(graphs))
     if workers <= 1:
         return run_dot(graphs)
     chunks = [graphs[i::workers] for i in range(workers)]

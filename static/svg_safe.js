@@ -15,17 +15,16 @@ export function sanitizeSvg(root) {
     }
     for (const attr of [...el.attributes]) {
       const name = attr.name.toLowerCase();
-      const value = attr.value.trim().toLowerCase();
       if (name.startsWith("on")
-          || ((name === "href" || name.endsWith(":href") || name === "src") && !value.startsWith("#"))
-          || (name === "style" && (value.includes("url(") || value.includes("javascript:")))) {
+          || ((name === "href" || name.endsWith(":href") || name === "src") && !attr.value.trim().startsWith("#"))
+          || (name === "style" && /url\(|javascript:/i.test(attr.value))) {
         el.removeAttribute(attr.name);
       }
     }
   }
   for (const el of doomed) el.remove();
   // Graphviz prefixes ids with "pageX,Y_" when it paginates; the contract's ids are without.
-  for (const el of root.querySelectorAll("[id]")) {
+  for (const el of root.querySelectorAll('[id^="page"]')) {
     const m = /^page\d+,\d+_([scoe]:.*)$/s.exec(el.id);
     if (m) el.id = m[1];
   }
@@ -40,5 +39,5 @@ export function parseSvg(text) {
     throw new Error("the server's graph is not valid SVG");
   }
   sanitizeSvg(svg);
-  return document.importNode(svg, true);
+  return document.adoptNode(svg); // moved, not copied
 }

@@ -8,7 +8,8 @@ relative imports become bare ``fsmscope/...`` specifiers that the map resolves, 
 modules that talk to a server (api.js, stream.js) are swapped for static/offline/'s, which answer
 the same questions from the recording embedded as JSON: its events, keyframes (statuses rebuilt by
 fsm's own reducer every KEYFRAME_EVERY events), the whole run's timeline (server/timeline.py) and
-the graph drawings (server/graph.py) the depth menu offers. Nothing user-provided is ever HTML:
+the graph drawings (server/graph.py) the depth menu offers and the state statistics
+(fsm/logfiles/summary.py) of the whole recording. Nothing user-provided is ever HTML:
 the JSON is escaped so that no text in it can end its script element.
 """
 
@@ -25,6 +26,7 @@ from typing import Callable, Iterable
 import orjson
 
 from fsm.logfiles.log_reader import Problem, read_events
+from fsm.logfiles.summary import Summary
 from fsm.observation import structure
 from fsm.observation.status import Status
 
@@ -87,7 +89,9 @@ def recorded_machine(name: str, events: list[dict]) -> dict:
     timeline = TimelineIndex()
     kept: list[dict] = []
     keyframes = [[0, _keyframe(status)]]
+    summary = Summary()
     for event in events:
+        summary.add(event)
         if event["kind"] == "snapshot":
             if event["seq"] > status.last_seq:
                 status.apply(event)
@@ -100,7 +104,18 @@ def recorded_machine(name: str, events: list[dict]) -> dict:
             keyframes.append([len(kept), _keyframe(status)])
     end = status.to_dict()
     return {"name": name, "events": kept, "keyframes": keyframes, "end": end,
-            "timeline": timeline.answer(buckets=TIMELINE_BUCKETS), "graphs": drawings(end["structure"])}
+            "timeline": timeline.answer(buckets=TIMELINE_BUCKETS), "graphs": drawings(end["structure"]),
+            "stats": state_stats(summary, name, kept)}
+
+
+def state_stats(summary: Summary, name: str, kept: list[dict]) -> dict:
+    """The whole recording's state statistics in GET /summary's shape (server/state_stats.py), every
+    state visited, and ``unvisited``: what a state never entered has."""
+    seen = summary.machines.get(name)
+    last = kept[-1]["seq"] if kept else None
+    return {"counted": {"first_seq": kept[0]["seq"] if kept else None, "last_seq": last}, "last_seq": last,
+            "complete": True, "states": {p: summary.state(name, p) for p in (seen.visits if seen else ())},
+            "unvisited": summary.state(name, "")}
 
 
 def depth_of(path: str, root_path: str) -> int:

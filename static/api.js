@@ -81,6 +81,7 @@ export const api = {
   /** Show a recorded pose in the 3D view (null: back to the live arm). */
   scenePose: (pose) => request("POST", "/api/scene/pose", { pose }),
   graphSvg: (name, expand) => request("GET", machine(name) + "/graph.svg" + query({ expand }), undefined, "text"),
+  anyOpenSet: true, // the server lays out any set of open containers (semantic zoom asks for them)
   preempt: (name, reason) => request("POST", machine(name) + "/preempt", { reason: reason || "" }),
   setInitialState: (name, path, states, userdata) => control("POST", name, "/initial-state", { path, states, userdata }),
   start: (name) => control("POST", name, "/start", {}),

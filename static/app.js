@@ -118,7 +118,7 @@ $("audit-btn").addEventListener("click", () => audit.open());
 const showsLive = () => stream?.state === "live" && !playhead.past; // the debugger controls only what it shows
 const breakpoints = new Breakpoints(store, controls, showsLive);
 const debugBar = new DebugBar(store, controls, showsLive);
-const depth = new Depth($("depth"), store, () => graph.openPaths(), (semantic) => loadGraph(semantic));
+const depth = new Depth($("depth"), store, () => graph.openPaths(), (semantic) => loadGraph(semantic), api.anyOpenSet);
 
 const details = new DetailsPanel($("details"), store, api);
 const search = new SearchPalette(store, () => shownStatus(), (entry) => goTo(entry));

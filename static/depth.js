@@ -13,8 +13,11 @@ export class Depth {
    * @param {() => string[]} drawnOpen the containers the graph shown draws open
    * @param {(semantic: boolean) => Promise<unknown>} changed called when another set of containers is
    *   to be drawn open (`semantic`: by semantic zoom, as the machine moves); resolves when it is drawn
+   * @param {boolean} anyOpenSet whether any set can be drawn (a server lays it out); else "auto" is the
+   *   default drawing, no semantic zoom (an exported file holds the depth menu's drawings only)
    */
-  constructor(select, store, drawnOpen, changed) {
+  constructor(select, store, drawnOpen, changed, anyOpenSet) {
+    this.anyOpenSet = anyOpenSet;
     this.select = select;
     this.store = store;
     this.drawnOpen = drawnOpen;
@@ -42,7 +45,7 @@ export class Depth {
 
   /** A drawing is in: under "auto", one that leaves containers closed turns semantic zoom on. */
   laidOut() {
-    if (this.expand || this.semanticOn || !this.store.status.structure) return;
+    if (!this.anyOpenSet || this.expand || this.semanticOn || !this.store.status.structure) return;
     const all = [...containers(this.store.status.structure)].length;
     if (this.drawnOpen().length >= all) return;
     this.semanticOn = true;

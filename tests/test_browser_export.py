@@ -7,12 +7,15 @@ from __future__ import annotations
 import json
 import urllib.parse
 
+import fsm
 import pytest
 from browser_support import ACTIVE_LEAF
-from export_support import MARKUP, NAME, exported_run, seq_of
-from recording_support import replay_served
+from export_support import LOOPS, MARKUP, NAME, exported_run, seq_of
+from recording_support import record, replay_served
 from fsm.logfiles.log_reader import seek
 from fsm.observation.schema import state_id
+from server import export_html
+from server.testing.big_machine import big_machine
 from server.testing.browser import open_page
 from server.testing.polling import wait_for
 
@@ -154,3 +157,47 @@ def test_play_runs_the_file_to_the_end_of_the_run(file_page, run):
     at_instant(file_page, last)
     wait_for(lambda: not file_page.evaluate("fsmscope.instant.playing"), 5, what="the playhead to stop at the end")
     assert {k: v for k, v in shown(file_page).items() if k in ("active", "containers")} == rebuilt(log, last)
+
+
+def test_details_show_the_state_statistics_of_the_recording(file_page):
+    file_page.click('#tree .tree-row[data-path="/SM_ROOT/SUB/B"]')
+    file_page.click("#details > summary")
+    wait_for(lambda: file_page.text_content("#details .details-visits") == str(LOOPS), 5,
+             what=lambda: "B's visits: %r" % file_page.text_content("#details .details-stats"))
+    assert file_page.text_content("#details .details-last-outcome") == "go"
+
+
+@pytest.fixture(scope="module")
+def big_run(tmp_path_factory):
+    """A recorded run of a machine too big to draw open (286 states: "auto" leaves its containers
+    closed), exported."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    sm, stop = big_machine(branching=2, depth=3, leaves=40)
+    seen = []
+
+    def stop_after_3000_events(event):
+        seen.append(event)
+        if len(seen) >= 3000:
+            stop.set()
+
+    fsm.attach(sm, stop_after_3000_events, name="big")
+    log = tmp_path_factory.mktemp("big-export") / "big.jsonl"
+    record(sm, log, name="big")
+    html = log.with_suffix(".html")
+    html.write_text(export_html.export_html(str(log)), encoding="utf-8")
+    return html
+
+
+def test_an_exported_big_machine_is_drawn_without_asking_for_drawings_the_file_lacks(browser, big_run):
+    page = browser.new_page(viewport={"width": 1280, "height": 800})
+    try:
+        page.goto(big_run.as_uri() + "#m=big&seq=1500")
+        page.wait_for_selector("#graph svg")
+        wait_for(lambda: page.evaluate("fsmscope.instant.seq") == 1500, 10,
+                 what=lambda: "event 1500 shown; the page is at %r" % page.evaluate("fsmscope.instant"))
+        page.wait_for_timeout(1000)  # semantic zoom would have asked for the running containers by now
+        assert page.evaluate("fsmscope.status.activePaths().length") > 1
+        assert page.text_content("#notice") == ""
+        assert page.eval_on_selector_all("#graph g.cluster", "gs => gs.map((g) => g.id)") == ["c:/SM_ROOT"]
+    finally:
+        page.close()

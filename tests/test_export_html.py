@@ -7,7 +7,7 @@ import json
 import re
 
 import pytest
-from export_support import MARKUP, NAME, exported_run
+from export_support import LOOPS, MARKUP, NAME, exported_run
 from recording_support import cli
 
 
@@ -84,3 +84,10 @@ def test_a_log_without_events_is_refused(tmp_path):
     done = cli("export", log, "--html", tmp_path / "run.html")
     assert done.returncode == 2
     assert "no events" in done.stderr
+
+
+def test_the_file_holds_the_state_statistics_replay_counts(run):
+    stats = embedded(run.html.read_text(encoding="utf-8"))["machines"][0]["stats"]
+    assert stats["states"]["/SM_ROOT/SUB/B"]["visits"] == LOOPS
+    assert stats["states"]["/SM_ROOT/CHECK"]["last_outcome"] == "done"
+    assert stats["complete"] and stats["unvisited"]["visits"] == 0

@@ -21,8 +21,9 @@ export const api = {
   history: (name, params) => answer(() => recorded(name).history(params)),
   timeline: (name, params) => answer(() => recorded(name).timeline(params)),
   scenePose: () => Promise.reject(new ApiError(404, "this file has no 3D view")),
-  summary: () => Promise.reject(new ApiError(404, "an exported run holds no state statistics")),
+  summary: (name, path) => answer(() => recorded(name).summary(path)),
   graphSvg: (name, expand) => answer(() => recorded(name).graphSvg(expand)),
+  anyOpenSet: false, // the file holds the drawings of the depth menu's levels only: no semantic zoom
   preempt: refuse,
   setInitialState: refuse,
   start: refuse,

@@ -2,7 +2,7 @@
 // server/export_html.py), answered as the server's REST API answers it (docs/api.md, "Time travel"):
 // the status at an event from the nearest keyframe and the events after it (status.js's reducer),
 // pages of history sliced from the events, the timeline the export computed, sliced to a range,
-// and the graph drawings the export made.
+// the graph drawings and the state statistics the export made.
 
 import { ApiError } from "../api.js";
 import { Status } from "../status.js";
@@ -53,6 +53,13 @@ class RecordedMachine {
     this.end = data.end;
     this.wholeTimeline = data.timeline;
     this.drawings = new Map(data.graphs.map(([expand, svg]) => [drawingKey(expand), svg]));
+    this.stats = data.stats;
+  }
+
+  /** The state statistics the export counted over the whole recording, of `path` (GET /summary's shape). */
+  summary(path) {
+    const { states, unvisited, ...counted } = this.stats;
+    return { ...counted, states: { [path]: states[path] ?? unvisited } };
   }
 
   get firstSeq() {

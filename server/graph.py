@@ -37,7 +37,9 @@ ET.register_namespace("xlink", XLINK_NS)
 _G = "{%s}g" % SVG_NS
 _POLYGON = "{%s}polygon" % SVG_NS
 _TITLE = "{%s}title" % SVG_NS
-_PAGE = re.compile(r"^page\d+,\d+_(?=[scoe]:)")  # dot's prefix of ids when it paginates (static/graph.js drops it too)
+# dot prefixes the ids of every graph after the first one a process lays out (and of pages) with this:
+# the contract's ids (docs/api.md) are without.
+_PAGE = re.compile(r"^page\d+,\d+_(?=[scoe]:)")
 _HOLE = re.compile(rb"<!--fsmscope-child-(\d+)-->")  # where an open child's drawing goes in its parent's text
 # A piece's own declarations: the document's root declares them once. Only these two: dot writes no other.
 _DECLARATIONS = re.compile(rb' xmlns(?::xlink)?="(?:%s|%s)"' % (SVG_NS.encode(), XLINK_NS.encode()))
@@ -287,6 +289,8 @@ class Renderer:
         for g in (group, *group.iter(_G)):
             title = g.find(_TITLE)
             eid = _PAGE.sub("", g.get("id", ""))
+            if eid:
+                g.set("id", eid)
             if title is not None and eid in titles:
                 title.text = titles[eid]
         group.set("class", "cluster")

@@ -23,11 +23,6 @@ export function sanitizeSvg(root) {
     }
   }
   for (const el of doomed) el.remove();
-  // Graphviz prefixes ids with "pageX,Y_" when it paginates; the contract's ids are without.
-  for (const el of root.querySelectorAll('[id^="page"]')) {
-    const m = /^page\d+,\d+_([scoe]:.*)$/s.exec(el.id);
-    if (m) el.id = m[1];
-  }
   return root;
 }
 

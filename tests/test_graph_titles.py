@@ -12,13 +12,12 @@ from server.testing.big_machine import big_machine
 
 SVG = "{http://www.w3.org/2000/svg}"
 GRAPHVIZ_NAME = re.compile(r"[no]\d+(->[no]\d+)?")
-PAGE = re.compile(r"^page\d+,\d+_")  # dot's prefix of ids when it paginates (the page drops it too)
 
 
 def drawn_titles(svg: bytes) -> dict[str, str]:
     """The title of each element with an id: {id: title}."""
     root = ET.fromstring(svg)
-    return {PAGE.sub("", g.get("id")): g.find(SVG + "title").text for g in root.iter(SVG + "g") if g.get("id")}
+    return {g.get("id"): g.find(SVG + "title").text for g in root.iter(SVG + "g") if g.get("id")}
 
 
 def big_structure() -> dict:

@@ -1,0 +1,115 @@
+"""The SMACH introspection messages of a ROS bag, read with rosbags (no ROS needed).
+
+smach_ros's IntrospectionServer publishes ``<server>/smach/container_structure`` and
+``<server>/smach/container_status``; every introspection server of the bag is found by those
+topics, and its messages come out in the bag's time order as plain dicts. ROS 1 ``.bag`` files and
+ROS 2 bags (a folder with metadata.yaml, or its ``.db3`` / ``.mcap`` file) are read.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Iterator
+
+from rosbags.highlevel import AnyReader
+
+from . import smach_msgs
+
+STRUCTURE_FIELDS = ("path", "children", "internal_outcomes", "outcomes_from", "outcomes_to", "container_outcomes")
+STATUS_FIELDS = ("path", "initial_states", "active_states", "info")
+
+
+class BagError(Exception):
+    """The bag cannot be read, or holds no SMACH introspection; the message says which."""
+
+
+@dataclass
+class Message:
+    """One introspection message: ``t`` in seconds (its header's stamp, else the bag's time), the
+    server it came from, ``kind`` "structure" or "status", its fields (``local_data`` as bytes)."""
+
+    t: float
+    server: str
+    kind: str
+    fields: dict
+
+
+def is_bag(path: str) -> bool:
+    """Whether ``path`` looks like a ROS bag (by its name and layout; its content is read later)."""
+    p = Path(path)
+    if p.is_dir():
+        return (p / "metadata.yaml").exists()
+    return p.suffix in (".bag", ".db3") or (p.suffix == ".mcap" and _mcap_profile(p) == "ros2")
+
+
+def _mcap_profile(path: Path) -> str:
+    """The profile an MCAP file's header names ("ros2" for a ROS 2 bag), "" when it has none."""
+    from mcap.reader import make_reader
+    try:
+        with open(path, "rb") as f:
+            return make_reader(f).get_header().profile
+    except Exception:  # not an MCAP at all: the caller says so when it reads it
+        return ""
+
+
+def _server(topic: str) -> tuple[str, str] | None:
+    for kind, suffix in (("structure", smach_msgs.STRUCTURE_TOPIC), ("status", smach_msgs.STATUS_TOPIC)):
+        if topic.endswith(suffix):
+            return topic[:-len(suffix)].strip("/") or "smach", kind
+    return None
+
+
+def read_bag(path: str) -> Iterator[Message]:
+    """Every introspection message of the bag at ``path``, in time order. Raises ``BagError``."""
+    p = Path(path)
+    if not p.exists():
+        raise BagError("%s: no such file or folder" % path)
+    ros2 = p.suffix != ".bag"
+    try:
+        reader = AnyReader([p], default_typestore=smach_msgs.typestore(ros2=True) if ros2 else None)
+        reader.open()
+    except Exception as exc:  # rosbags raises its own errors, sqlite's, KeyError for odd definitions
+        raise BagError("%s: cannot read this bag (%s: %s)" % (path, type(exc).__name__, exc)) from None
+    try:
+        found = {c.id: _server(c.topic) for c in reader.connections}
+        wanted = [c for c in reader.connections if found[c.id] and c.msgtype in (smach_msgs.STRUCTURE, smach_msgs.STATUS)]
+        if not wanted:
+            topics = sorted({c.topic for c in reader.connections})
+            raise BagError("%s: no SMACH introspection topics (…%s, …%s) among its %d topics%s" % (
+                path, smach_msgs.STRUCTURE_TOPIC, smach_msgs.STATUS_TOPIC, len(topics),
+                (": " + ", ".join(topics[:8])) if topics else ""))
+        lenient = None if ros2 else smach_msgs.typestore(ros2=False, local_data_bytes=True)
+        ours = None if ros2 else smach_msgs.typestore(ros2=False).generate_msgdef(smach_msgs.STATUS)[1]
+        count = 0
+        try:
+            for connection, stamp, raw in reader.messages(connections=wanted):
+                server, kind = found[connection.id]
+                if kind == "status" and lenient is not None and connection.digest == ours:
+                    msg = lenient.deserialize_ros1(raw, smach_msgs.STATUS)  # a raw pickle is no UTF-8
+                else:
+                    msg = reader.deserialize(raw, connection.msgtype)
+                yield Message(_time(msg, stamp), server, kind, _fields(msg, kind))
+                count += 1
+        except BagError:
+            raise
+        except Exception as exc:  # a bag cut short: what came before it was yielded
+            raise BagError("%s: the bag is damaged after %d introspection messages (%s: %s)" % (
+                path, count, type(exc).__name__, exc)) from None
+    finally:
+        reader.close()
+
+
+def _time(msg: object, stamp_ns: int) -> float:
+    stamp = msg.header.stamp
+    return stamp.sec + stamp.nanosec * 1e-9 if stamp.sec or stamp.nanosec else stamp_ns * 1e-9
+
+
+def _fields(msg: object, kind: str) -> dict:
+    names = STRUCTURE_FIELDS if kind == "structure" else STATUS_FIELDS
+    out = {name: getattr(msg, name) for name in names}
+    if kind == "status":
+        data = msg.local_data
+        out["local_data"] = data.encode("utf-8", "surrogateescape") if isinstance(data, str) else bytes(data)
+    return out
+

@@ -8,7 +8,7 @@ in time order) become one machine's events:
 
 - ``structure``: the tree from every container's first structure message (a container with none
   gets the states its statuses named); a container is a Concurrence when a status shows more than
-  one active state, else a StateMachine; a leaf's outcomes are those of its edges. Emitted once,
+  one initial or active state, else a StateMachine; a leaf's outcomes are those of its edges. Emitted once,
   before the first other event.
 - ``start``: a container seen running (its active states not ``['None']``) that was not; the
   containers above it start first. A container first seen beyond its initial state starts there
@@ -62,7 +62,7 @@ class _Tree:
             for s in [*f["initial_states"], *f["active_states"]]:
                 if s != NONE and s not in states:
                     states.append(s)
-            if len(f["active_states"]) > 1:
+            if len(f["active_states"]) > 1 or len(f["initial_states"]) > 1:  # a Concurrence starts them all
                 self.concurrent.add(f["path"])
         self.paths = set(self.structures) | set(self.named)
         roots = sorted((p for p in self.paths if _parent(p) not in self.paths), key=len)
@@ -139,16 +139,15 @@ class _Machine:
             yield self._event("log", path, {"level": "warn", "msg": "userdata not read: %s" % exc})
         if not isinstance(data, dict):
             data = {"local_data": data}
-        active = [s for s in f["active_states"] if s != NONE]
-        running = f["active_states"] != [NONE] and bool(f["active_states"] or path in self.tree.concurrent)
+        active = [s for s in f["active_states"] if s != NONE]  # an idle Concurrence's: none, not ['None']
         if path in self.active:
             yield from self._userdata(path, data)
             if f["active_states"] == [NONE]:
                 yield from self._terminate(path, None)
             else:
                 yield from self._move(path, active)
-        elif running:
-            yield from self._start(path, active or self.tree.initial.get(path, []), data)
+        elif active:
+            yield from self._start(path, active, data)
         else:
             self.userdata[path] = data
 

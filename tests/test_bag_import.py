@@ -1,0 +1,132 @@
+"""ROS bags of a SMACH run (written by the tests as smach_ros publishes, bag_support.py) read without ROS:
+the same events from every layout, what the run did, userdata never run, and clear words for bags
+that cannot be read."""
+
+from __future__ import annotations
+
+import os
+import pickle
+
+import pytest
+from bag_support import GRASP, PLACE, ROOT, messages, write_bag
+from recording_support import cli
+
+from fsm.logfiles.log_reader import read_events
+from fsm.observation import schema
+from interop import bag_reader, smach_events
+
+LAYOUTS = {"ros1": "run.bag", "ros1-raw": "run.bag", "ros2-sqlite3": "run", "ros2-mcap": "run"}
+
+
+def events_of(bag) -> list[dict]:
+    return list(smach_events.events(bag_reader.read_bag(str(bag))))
+
+
+@pytest.fixture(scope="module")
+def noetic_events(tmp_path_factory):
+    return events_of(write_bag(tmp_path_factory.mktemp("noetic") / "run.bag", "ros1"))
+
+
+@pytest.mark.parametrize("layout", ["ros1-raw", "ros2-sqlite3", "ros2-mcap"])
+def test_every_layout_gives_the_events_of_a_noetic_bag(layout, tmp_path, noetic_events):
+    assert events_of(write_bag(tmp_path / LAYOUTS[layout], layout)) == noetic_events
+
+
+def test_every_event_is_one_of_the_schema(noetic_events):
+    assert [schema.validate(ev) for ev in noetic_events] == [None] * len(noetic_events)
+
+
+def test_the_structure_has_the_containers_their_states_and_edges(noetic_events):
+    root = noetic_events[0]["root"]
+    grasp = next(c for c in root["children"] if c["path"] == GRASP)
+    assert [c["label"] for c in root["children"]] == ["FIND", "GRASP", "PLACE"]
+    assert grasp["type"] == "Concurrence" and grasp["outcomes"] == ["failed", "grasped"]
+    assert {"from": "FIND", "outcome": "found", "to": "GRASP"} in root["transitions"]
+    place = next(c for c in root["children"] if c["path"] == PLACE)
+    assert {"from": "RELEASE", "outcome": "preempted", "to": None} in place["transitions"]
+
+
+def test_the_run_is_told_as_it_went(noetic_events):
+    told = [(ev["kind"], ev["path"], ev.get("from"), ev.get("outcome"), ev.get("to")) for ev in noetic_events[1:]
+            if ev["kind"] in ("start", "transition", "terminate")]
+    assert told == [
+        ("start", ROOT, None, None, None), ("transition", ROOT, "FIND", "found", "GRASP"),
+        ("start", GRASP, None, None, None), ("transition", GRASP, "ARM", "reached", None),
+        ("transition", GRASP, "GRIPPER", "closed", None), ("terminate", GRASP, None, "grasped", None),
+        ("transition", ROOT, "GRASP", "grasped", "PLACE"), ("start", PLACE, None, None, None),
+        ("transition", PLACE, "MOVE", "moved", "RELEASE"), ("terminate", PLACE, None, "placed", None),
+        ("terminate", ROOT, None, "succeeded", None)]
+
+
+def test_userdata_is_decoded_and_its_changes_are_events(noetic_events):
+    start = next(ev for ev in noetic_events if ev["kind"] == "start" and ev["path"] == ROOT)
+    assert start["userdata"] == {"target": "cup", "tries": 1, "seen": [0.4, 0.1]}
+    changes = [ev["changes"] for ev in noetic_events if ev["kind"] == "userdata"]
+    assert changes == [{"opened": True}, {"done": ["ok"]}]
+
+
+class Shell:
+    def __init__(self, marker: str) -> None:
+        self.marker = marker
+
+    def __reduce__(self):
+        return (os.system, ("touch %s" % self.marker,))
+
+
+def test_a_userdata_pickle_that_calls_os_system_runs_nothing(tmp_path):
+    marker = tmp_path / "ran"
+    run = [(t, topic, kind, dict(fields, userdata={"goal": Shell(str(marker))}) if kind == "status" else fields)
+           for t, topic, kind, fields in messages()]
+    start = next(ev for ev in events_of(write_bag(tmp_path / "evil.bag", "ros1", run)) if ev["kind"] == "start")
+    assert not marker.exists()
+    assert start["userdata"]["goal"] == {"$repr": "<opaque posix.system>"}
+
+
+def test_each_introspection_server_is_a_machine(tmp_path):
+    both = sorted(messages("left_arm") + messages("right_arm"), key=lambda m: m[0])
+    machines = {ev["machine"] for ev in events_of(write_bag(tmp_path / "two.bag", "ros1", both))}
+    assert machines == {"left_arm", "right_arm"}
+
+
+def test_a_bag_without_smach_topics_says_which_topics_it_has(tmp_path):
+    chatter = [(t, "/chatter/smach/other", kind, fields) for t, _, kind, fields in messages()[:1]]
+    bag = write_bag(tmp_path / "other.bag", "ros1", chatter)
+    with pytest.raises(bag_reader.BagError, match="no SMACH introspection topics .* 1 topics: /chatter/smach/other"):
+        events_of(bag)
+
+
+def test_a_truncated_bag_cannot_be_read_and_says_so(tmp_path):
+    bag = write_bag(tmp_path / "cut.bag", "ros1")
+    bag.write_bytes(bag.read_bytes()[: bag.stat().st_size // 2])
+    with pytest.raises(bag_reader.BagError, match="cut.bag: cannot read this bag"):
+        events_of(bag)
+
+
+def test_import_writes_a_log_that_reads_back_as_the_same_events(tmp_path, noetic_events):
+    bag = write_bag(tmp_path / "run.bag", "ros1")
+    done = cli("import", bag, "-o", tmp_path / "run.jsonl")
+    assert done.returncode == 0, done.stderr
+    kept = [ev for ev in read_events(str(tmp_path / "run.jsonl")) if ev["kind"] != "snapshot"]
+    assert kept == noetic_events
+
+
+def test_import_of_a_truncated_bag_exits_2_and_writes_nothing(tmp_path):
+    bag = write_bag(tmp_path / "cut.bag", "ros1")
+    bag.write_bytes(bag.read_bytes()[:100])
+    done = cli("import", bag, "-o", tmp_path / "cut.jsonl")
+    assert done.returncode == 2 and "cannot read this bag" in done.stderr
+    assert not (tmp_path / "cut.jsonl").exists()
+
+
+def test_import_of_a_bag_without_smach_topics_exits_2(tmp_path):
+    bag = write_bag(tmp_path / "other.bag", "ros1", [(t, "/chatter/smach/other", k, f) for t, _, k, f in messages()[:1]])
+    done = cli("import", bag, "-o", tmp_path / "other.jsonl")
+    assert done.returncode == 2 and "no SMACH introspection topics" in done.stderr
+
+
+def test_replay_of_a_bag_prints_the_run_and_its_statistics(tmp_path):
+    bag = write_bag(tmp_path / "run", "ros2-mcap")
+    done = cli("replay", bag, "--no-time")
+    assert done.returncode == 0, done.stderr
+    assert "State machine transitioning 'GRASP':'grasped'-->'PLACE'" in done.stdout
+    assert "machine pick_place: finished with outcome 'succeeded'" in done.stdout

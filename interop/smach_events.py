@@ -27,7 +27,7 @@ import heapq
 from typing import Iterable, Iterator
 
 from fsm.observation import schema
-from fsm.observation.encoding import encode, encode_userdata
+from fsm.observation.encoding import dumps, encode_userdata
 
 from . import safe_pickle
 from .bag_reader import Message
@@ -115,7 +115,7 @@ class _Machine:
         self.active: dict[str, list[str]] = {}  # running containers -> their active states
         self.left: dict[str, list[str]] = {}  # container -> the states that left it last (its last ones)
         self.ended: dict[str, str] = {}  # container -> the outcome it terminated with, when known
-        self.userdata: dict[str, dict] = {}  # container -> its decoded userdata, last seen
+        self.userdata: dict[str, dict] = {}  # container -> its userdata, last seen, encoded
         self.seq = 0
         self.runs = 0
         self.run: str | None = None
@@ -139,6 +139,7 @@ class _Machine:
             yield self._event("log", path, {"level": "warn", "msg": "userdata not read: %s" % exc})
         if not isinstance(data, dict):
             data = {"local_data": data}
+        data = encode_userdata(data)  # compared and sent encoded: each value encoded once
         active = [s for s in f["active_states"] if s != NONE]  # an idle Concurrence's: none, not ['None']
         if path in self.active:
             yield from self._userdata(path, data)
@@ -165,7 +166,7 @@ class _Machine:
         self.active[path] = list(initial)
         self.userdata[path] = data
         yield self._event("start", path, {"initial": initial, "active": list(initial),
-                                          "userdata": encode_userdata(data)})
+                                          "userdata": data})
         yield from self._move(path, seen)
 
     def _move(self, path: str, now: list[str]) -> Iterator[dict]:
@@ -216,10 +217,10 @@ class _Machine:
 
     def _userdata(self, path: str, data: dict) -> Iterator[dict]:
         old = self.userdata.get(path, {})
-        changed = {k: v for k, v in data.items() if k not in old or encode(old[k]) != encode(v)}
+        changed = {k: v for k, v in data.items() if k not in old or dumps(old[k]) != dumps(v)}  # 1 is not True
         self.userdata[path] = data
         if changed:
-            yield self._event("userdata", path, {"changes": encode_userdata(changed)})
+            yield self._event("userdata", path, {"changes": changed})
 
 
 def events(messages: Iterable[Message]) -> Iterator[dict]:

@@ -10,15 +10,9 @@ The run is a pick and place: /SM_ROOT: FIND --found--> GRASP (a Concurrence of A
 
 from __future__ import annotations
 
-import base64
-import pickle
 from pathlib import Path
 
-import numpy
-from rosbags.rosbag1 import Writer as Writer1
-from rosbags.rosbag2 import StoragePlugin, Writer as Writer2
-
-from interop import smach_msgs
+from interop.testing import write_bag as write
 
 T0 = 1_700_000_000.0
 ROOT, GRASP, PLACE = "/SM_ROOT", "/SM_ROOT/GRASP", "/SM_ROOT/PLACE"
@@ -67,45 +61,6 @@ def messages(server: str = "pick_place") -> list[tuple[float, str, str, dict]]:
     return [(T0 + t, "/%s/smach/container_%s" % (server, kind), kind, fields) for t, kind, fields in out]
 
 
-def _message(store, kind: str, fields: dict, t: float, ros2: bool, raw_pickle: bool):
-    Header, Time = store.types["std_msgs/msg/Header"], store.types["builtin_interfaces/msg/Time"]
-    stamp = Time(sec=int(t), nanosec=int(round((t % 1) * 1e9)))
-    header = Header(stamp=stamp, frame_id="") if ros2 else Header(seq=0, stamp=stamp, frame_id="")
-    if kind == "structure":
-        return store.types[smach_msgs.STRUCTURE](header=header, **fields)
-    data = {k: v for k, v in fields.items() if k != "userdata"}
-    pickled = pickle.dumps(fields["userdata"], 2)
-    if ros2 or raw_pickle:
-        data["local_data"] = numpy.frombuffer(pickled, dtype=numpy.uint8)
-    else:
-        data["local_data"] = base64.b64encode(pickled).decode()
-    return store.types[smach_msgs.STATUS](header=header, **data)
-
-
 def write_bag(path: Path, layout: str, runs: list[tuple[float, str, str, dict]] | None = None) -> Path:
-    """The run (or ``runs``: (t, topic, kind, fields)) written to a bag at ``path``: ``layout`` "ros1"
-    (noetic), "ros1-raw" (the raw pickle of older releases), "ros2-sqlite3" or "ros2-mcap"."""
-    runs = runs if runs is not None else messages()
-    ros2 = layout.startswith("ros2")
-    raw = layout == "ros1-raw"
-    store = smach_msgs.typestore(ros2=ros2, local_data_bytes=raw)
-    types = {"structure": smach_msgs.STRUCTURE, "status": smach_msgs.STATUS}
-    if ros2:
-        plugin = StoragePlugin.MCAP if layout == "ros2-mcap" else StoragePlugin.SQLITE3
-        writer = Writer2(path, version=8, storage_plugin=plugin)
-    else:
-        writer = Writer1(path)
-    with writer:
-        connections = {}
-        for t, topic, kind, fields in runs:
-            if topic not in connections:
-                if raw and kind == "status":  # the wire form of a raw pickle's string: the noetic md5 and definition
-                    noetic = smach_msgs.typestore(ros2=False)
-                    msgdef, md5 = noetic.generate_msgdef(types[kind])
-                    connections[topic] = writer.add_connection(topic, types[kind], msgdef=msgdef, md5sum=md5)
-                else:
-                    connections[topic] = writer.add_connection(topic, types[kind], typestore=store)
-            msg = _message(store, kind, fields, t, ros2, raw)
-            data = store.serialize_cdr(msg, types[kind]) if ros2 else store.serialize_ros1(msg, types[kind])
-            writer.write(connections[topic], int(t * 1e9), data)
-    return path
+    """The run (or ``runs``) written to a bag at ``path`` in ``layout`` (interop.testing.write_bag)."""
+    return write(path, layout, messages() if runs is None else runs)

@@ -18,10 +18,10 @@ from pathlib import Path
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from fsm.logfiles.log_reader import read_events  # noqa: E402
-from interop.bag_log import write_log  # noqa: E402
 from interop.bag_reader import read_bag  # noqa: E402
 from interop.smach_events import events  # noqa: E402
 from interop.testing import write_bag  # noqa: E402
+from interop.to_log import write_log  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 REPEATS = 3
@@ -57,7 +57,7 @@ def main() -> None:
         seconds, count = timed(lambda: sum(1 for _ in events(read_bag(str(bag)))))
         converted.append(count / seconds)
         log = str(folder / ("loop-%d.jsonl" % i))
-        seconds, written = timed(lambda: write_log(str(bag), log))
+        seconds, written = timed(lambda: write_log(events(read_bag(str(bag))), log))
         imported.append(written / seconds)
         seconds, back = timed(lambda: sum(1 for _ in read_events(log)))
         read.append(back / seconds)

@@ -15,12 +15,13 @@ from typing import Iterator
 from rosbags.highlevel import AnyReader
 
 from . import smach_msgs
+from .to_log import ReadError
 
 STRUCTURE_FIELDS = ("path", "children", "internal_outcomes", "outcomes_from", "outcomes_to", "container_outcomes")
 STATUS_FIELDS = ("path", "initial_states", "active_states", "info")
 
 
-class BagError(Exception):
+class BagError(ReadError):
     """The bag cannot be read, or holds no SMACH introspection; the message says which."""
 
 

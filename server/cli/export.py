@@ -1,5 +1,6 @@
 """``fsmscope export LOG --html OUT.html``: a recorded run as one HTML file that opens from disk with
-no server and no network (server/export_html.py)."""
+no server and no network (server/export_html.py); ``--mcap OUT.mcap``: as MCAP, which Foxglove
+opens (interop/mcap_log.py)."""
 
 from __future__ import annotations
 
@@ -16,14 +17,19 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     from ..export_html import MAX_MB
 
     parser.add_argument("log", metavar="RUN.jsonl", help="a log written by the recorder")
-    parser.add_argument("--html", metavar="OUT.html", required=True,
-                        help="the file to write: open it in a browser (file://); it needs nothing else")
+    out = parser.add_mutually_exclusive_group(required=True)
+    out.add_argument("--html", metavar="OUT.html",
+                     help="the file to write: open it in a browser (file://); it needs nothing else")
+    out.add_argument("--mcap", metavar="OUT.mcap",
+                     help="an MCAP file for Foxglove (and `fsmscope replay`): events, active states, log lines, pose")
     parser.add_argument("--max-mb", type=float, default=MAX_MB,
                         help="refuse a log larger than this many megabytes (default %(default)s): the whole "
                              "run goes into the page, which the browser holds in memory")
 
 
 def main(args: argparse.Namespace) -> int:
+    if args.mcap:
+        return export_mcap(args)
     from fsm.logfiles.log_reader import LogError
 
     from ..export_html import ExportError, export_html
@@ -42,4 +48,26 @@ def main(args: argparse.Namespace) -> int:
     os.replace(partial, args.html)
     print("fsmscope: wrote %s (%.1f MB); open it in a browser" % (args.html, len(text.encode()) / 2**20),
           file=sys.stderr)
+    return 0
+
+
+def export_mcap(args: argparse.Namespace) -> int:
+    """The log's events as an MCAP file (interop/mcap_log.py); the arm's links as frames when the log
+    recorded the demo's pose."""
+    from fsm.logfiles.log_reader import LogError, read_events
+    from interop.mcap_log import McapLogError, write_mcap
+
+    def skipped(problem: object) -> None:
+        print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
+
+    try:
+        written = write_mcap(read_events(args.log, on_problem=skipped), args.mcap)
+    except (McapLogError, LogError) as exc:
+        print("fsmscope export: %s" % exc, file=sys.stderr)
+        return EXIT_UNREADABLE
+    if not written:
+        os.remove(args.mcap)
+        print("fsmscope export: %s: no events" % args.log, file=sys.stderr)
+        return EXIT_UNREADABLE
+    print("fsmscope: wrote %s (%d events)" % (args.mcap, written), file=sys.stderr)
     return 0

@@ -22,8 +22,8 @@ SPEEDS = (0.1, 10.0)  # the page's play speeds
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("log", metavar="RUN.jsonl", help="a log written by the recorder, or a ROS bag of SMACH runs "
-                                                         "(read as `fsmscope import` reads it)")
+    parser.add_argument("log", metavar="RUN.jsonl", help="a log written by the recorder, a ROS bag of SMACH runs or "
+                                                         "fsmscope's MCAP (read as `fsmscope import` reads them)")
     parser.add_argument("--json", action="store_true", help="print only the summary, as JSON")
     parser.add_argument("--follow", "-f", action="store_true",
                         help="tail a log still being written, until its writer closes it")
@@ -49,28 +49,29 @@ def play_speed(text: str) -> float:
 
 
 def main(args: argparse.Namespace) -> int:
-    from interop.bag_reader import is_bag
+    from .bag_import import converts
 
-    if is_bag(args.log):
-        return replay_bag(args)
+    if converts(args.log):
+        return replay_converted(args)
     if args.serve:
         return replay_in_browser(args)
     return replay_in_terminal(args)
 
 
-def replay_bag(args: argparse.Namespace) -> int:
-    """A ROS bag's SMACH runs, turned into a log in a temporary folder (``fsmscope import``), replayed."""
+def replay_converted(args: argparse.Namespace) -> int:
+    """A ROS bag's SMACH runs, or fsmscope's MCAP, turned into a log in a temporary folder (as
+    ``fsmscope import`` does), replayed."""
     import os
     import tempfile
 
-    from .bag_import import EXIT_UNREADABLE as BAG_UNREADABLE, convert
+    from .bag_import import EXIT_UNREADABLE as SOURCE_UNREADABLE, convert
 
     if args.follow:
-        print("fsmscope replay: --follow tails a log being written; a bag is read whole", file=sys.stderr)
+        print("fsmscope replay: --follow tails a log being written; %s is read whole" % args.log, file=sys.stderr)
         return EXIT_UNREADABLE
-    with tempfile.TemporaryDirectory(prefix="fsmscope-bag-") as folder:
-        bag, args.log = args.log, os.path.join(folder, os.path.basename(args.log.rstrip("/")) + ".jsonl")
-        if convert(bag, args.log, "replay") == BAG_UNREADABLE:
+    with tempfile.TemporaryDirectory(prefix="fsmscope-replay-") as folder:
+        source, args.log = args.log, os.path.join(folder, os.path.basename(args.log.rstrip("/")) + ".jsonl")
+        if convert(source, args.log, "replay") == SOURCE_UNREADABLE:
             return EXIT_UNREADABLE
         return replay_in_browser(args) if args.serve else replay_in_terminal(args)
 

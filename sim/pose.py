@@ -150,3 +150,23 @@ class PoseTap:
 
 
 __all__ = ["DEFAULT_RATE", "PoseLayout", "PoseTap", "pose_qpos", "tick_at"]
+
+
+class PoseFrames:
+    """Every body of the model where a recorded pose puts it, by forward kinematics (no physics):
+    ``(parent frame, body, [x, y, z], [qw, qx, qy, qz])`` with each body a frame of "world", as a
+    tool that draws frames wants them (Foxglove's 3D panel, through ``fsmscope export --mcap``)."""
+
+    def __init__(self) -> None:
+        from .world import load_model
+
+        self.model = load_model()
+        self.layout = PoseLayout(self.model)
+        self.data = mujoco.MjData(self.model)
+
+    def __call__(self, pose: PoseFields) -> list[tuple[str, str, list[float], list[float]]]:
+        """Raises ValueError for a joint or body this model does not have (a pose of another robot)."""
+        self.data.qpos[:] = self.layout.qpos(pose)
+        mujoco.mj_kinematics(self.model, self.data)
+        return [("world", self.model.body(b).name, np.round(self.data.xpos[b], DECIMALS).tolist(),
+                 np.round(self.data.xquat[b], DECIMALS).tolist()) for b in range(1, self.model.nbody)]

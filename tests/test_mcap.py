@@ -87,3 +87,15 @@ def test_exporting_over_an_existing_file_is_refused(run, tmp_path):
     out.write_bytes(b"keep")
     done = cli("export", run.log, "--mcap", out)
     assert done.returncode == 2 and "exists already" in done.stderr and out.read_bytes() == b"keep"
+
+
+def test_the_demo_arm_is_exported_as_a_frame_per_body_at_every_recorded_pose(headless_demo_log, tmp_path):
+    from sim.pose import PoseFrames
+
+    out = tmp_path / "demo.mcap"
+    done = cli("export", headless_demo_log, "--mcap", out)
+    assert done.returncode == 0, done.stderr
+    poses = sum(e["kind"] == "pose" for e in read_events(str(headless_demo_log)))
+    bodies = PoseFrames().model.nbody - 1
+    assert poses > 0
+    assert summary(out)["/tf"] == ("protobuf", "foxglove.FrameTransform", "protobuf", poses * bodies)

@@ -53,7 +53,7 @@ class McapLogError(ReadError):
     """The file is no MCAP fsmscope wrote, or is damaged; the message says which."""
 
 
-def event_schema() -> dict:
+def _event_schema() -> dict:
     """The JSON Schema of an event, from fsm.observation.schema (the envelope; each kind's own fields
     are named in its description)."""
     return {"title": "fsmscope.Event", "type": "object", "description": "An fsmscope event (docs/events.md).",
@@ -65,6 +65,7 @@ def event_schema() -> dict:
             "required": ["v", "seq", "t", "run", "machine", "kind", "path"]}
 
 
+EVENT_SCHEMA = _event_schema()
 STATE_SCHEMA = {"title": "fsmscope.State", "type": "object",
                 "description": "The machine's active states after an event: Foxglove's State Transitions panel "
                                "plots `active`.",
@@ -106,13 +107,18 @@ class _Out:
         return self.channels[topic]
 
     def json(self, topic: str, schema_: dict, t: float, message: dict) -> None:
-        sid = self.schema(schema_["title"], SchemaEncoding.JSONSchema, json.dumps(schema_).encode())
-        self._add(self.channel(topic, MessageEncoding.JSON, sid), t, dumps(message))
+        channel = self.channels.get(topic)
+        if channel is None:
+            sid = self.schema(schema_["title"], SchemaEncoding.JSONSchema, json.dumps(schema_).encode())
+            channel = self.channel(topic, MessageEncoding.JSON, sid)
+        self._add(channel, t, dumps(message))
 
     def foxglove(self, topic: str, message: Log | FrameTransform, t: float) -> None:
-        known = type(message).get_schema()
-        sid = self.schema(known.name, known.encoding, bytes(known.data))
-        self._add(self.channel(topic, known.encoding, sid), t, message.encode())
+        channel = self.channels.get(topic)
+        if channel is None:
+            known = type(message).get_schema()
+            channel = self.channel(topic, known.encoding, self.schema(known.name, known.encoding, bytes(known.data)))
+        self._add(channel, t, message.encode())
 
     def _add(self, channel: int, t: float, data: bytes) -> None:
         self.writer.add_message(channel_id=channel, log_time=_ns(t), publish_time=_ns(t), data=data,
@@ -137,7 +143,7 @@ def write_mcap(events: Iterable[dict], out: str, frames: Callable[[dict], list[F
                 if event["kind"] == "snapshot":
                     continue
                 machine, t = event["machine"], event["t"]
-                o.json(EVENTS % machine, event_schema(), t, event)
+                o.json(EVENTS % machine, EVENT_SCHEMA, t, event)
                 written += 1
                 status = statuses.setdefault(machine, Status(machine))
                 status.apply(event)

@@ -68,18 +68,31 @@ def test_a_pose_becomes_frame_transforms_of_its_bodies(tmp_path):
     assert summary(tmp_path / "pose.mcap")["/tf"] == ("protobuf", "foxglove.FrameTransform", "protobuf", 3)
 
 
-def test_a_file_cut_short_yields_the_events_before_the_cut_then_says_so(tmp_path):
+@pytest.fixture
+def cut_short(tmp_path):
+    """(the events of a 3,000-step loop, their MCAP file cut at two thirds of its size)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     _, events = record(two_state_loop(3000), tmp_path / "loop.jsonl", name="loop")
     whole = tmp_path / "loop.mcap"
     write_mcap(events, str(whole))
     cut = tmp_path / "cut.mcap"
     cut.write_bytes(whole.read_bytes()[: whole.stat().st_size * 2 // 3])
+    return events, cut
+
+
+def test_a_file_cut_short_yields_the_events_before_the_cut_then_says_so(cut_short):
+    events, cut = cut_short
     read = []
     with pytest.raises(McapLogError, match="damaged after"):
         for event in read_mcap(str(cut)):
             read.append(event)
     assert 0 < len(read) < len(events) and read == events[:len(read)]
+
+
+def test_replaying_a_file_cut_short_replays_what_came_before_and_exits_1(cut_short):
+    done = cli("replay", cut_short[1], "--no-time")
+    assert done.returncode == 1 and "damaged after" in done.stderr and "events before it were kept" in done.stderr
+    assert "State machine transitioning 'A':'go'-->'B'" in done.stdout
 
 
 def test_exporting_over_an_existing_file_is_refused(run, tmp_path):

@@ -71,9 +71,10 @@ def replay_converted(args: argparse.Namespace) -> int:
         return EXIT_UNREADABLE
     with tempfile.TemporaryDirectory(prefix="fsmscope-replay-") as folder:
         source, args.log = args.log, os.path.join(folder, os.path.basename(args.log.rstrip("/")) + ".jsonl")
-        if convert(source, args.log, "replay") == SOURCE_UNREADABLE:
+        converted = convert(source, args.log, "replay")
+        if converted == SOURCE_UNREADABLE:
             return EXIT_UNREADABLE
-        return replay_in_browser(args) if args.serve else replay_in_terminal(args)
+        return (replay_in_browser(args) if args.serve else replay_in_terminal(args)) or converted
 
 
 def reader_of(log: str) -> Reader:

@@ -93,17 +93,18 @@ class Channels:
         self.transcript = Transcript()
 
     def messages(self, event: dict) -> list[Message]:
-        """What ``event`` puts on the channels (nothing for a snapshot: it is no event of the run)."""
-        if event["kind"] == "snapshot":
-            return []
+        """What ``event`` puts on the channels. A snapshot (a machine joined mid-run) puts its active
+        states only: it is no event of the run."""
         machine, t = event["machine"], event["t"]
+        if event["kind"] == "snapshot":
+            status = self.statuses[machine] = Status.from_dict(dict(event["status"], machine=machine))
+            self.transcript.structures.apply(event)
+            return [self._state(status, event)]
         out = [Message(EVENTS % machine, t, event, EVENT_SCHEMA)]
         status = self.statuses.setdefault(machine, Status(machine))
         status.apply(event)
         if event["kind"] in STATE_KINDS:
-            active = status.active_leaves()
-            out.append(Message(STATE % machine, t, {"active": max(active, key=len, default=""), "active_states": active,
-                                                    "seq": event["seq"], "kind": event["kind"]}, STATE_SCHEMA))
+            out.append(self._state(status, event))
         for line in self.transcript.lines(event):
             out.append(Message(LOG, t, Log(timestamp=stamp(t), level=LEVELS.get(line.level, LogLevel.Info),
                                            message=line.msg, name=machine + ":" + line.path, file="", line=0)))
@@ -114,3 +115,10 @@ class Channels:
                     translation=Vector3(x=xyz[0], y=xyz[1], z=xyz[2]),
                     rotation=Quaternion(x=wxyz[1], y=wxyz[2], z=wxyz[3], w=wxyz[0]))))
         return out
+
+    @staticmethod
+    def _state(status: Status, event: dict) -> Message:
+        active = status.active_leaves()
+        return Message(STATE % event["machine"], event["t"], {"active": max(active, key=len, default=""),
+                                                              "active_states": active, "seq": event["seq"],
+                                                              "kind": event["kind"]}, STATE_SCHEMA)

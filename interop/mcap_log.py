@@ -80,9 +80,10 @@ def write_mcap(events: Iterable[dict], out: str, frames: Callable[[dict], list[F
         with open(partial, "wb") as stream:
             o = _Out(stream)
             for event in events:
-                messages = channels.messages(event)
-                written += bool(messages)
-                for m in messages:
+                if event["kind"] == "snapshot":  # no event of the run: the recorder's, for seeking
+                    continue
+                written += 1
+                for m in channels.messages(event):
                     o.add(m)
             o.writer.finish()
     except BaseException:

@@ -7,7 +7,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-from typing import Callable
 
 HELP = "write a recorded run as one HTML file that shows it in the dashboard, from disk, with no server"
 PASSES_ARGUMENTS_ON = False
@@ -58,6 +57,8 @@ def export_mcap(args: argparse.Namespace) -> int:
     from fsm.logfiles.log_reader import LogError, read_events
     from interop.mcap_log import McapLogError, write_mcap
 
+    from .arm_frames import arm_frames
+
     def skipped(problem: object) -> None:
         print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
 
@@ -73,21 +74,3 @@ def export_mcap(args: argparse.Namespace) -> int:
     print("fsmscope: wrote %s (%d events)" % (args.mcap, written), file=sys.stderr)
     return 0
 
-
-def arm_frames() -> Callable[[dict], list] | None:
-    """A pose event's frames: the demo arm's every body by forward kinematics (sim), falling back to
-    the pose's free bodies for a pose of another robot; None without the simulator installed."""
-    try:
-        from sim.pose import PoseFrames
-    except ImportError:
-        return None
-    from interop.mcap_log import body_frames
-
-    arm = PoseFrames()
-
-    def frames(event: dict) -> list:
-        try:
-            return arm(event)
-        except ValueError:  # a joint the demo's arm does not have
-            return body_frames(event)
-    return frames

@@ -36,18 +36,32 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
                              "--deadman-action (default %(default)s)")
     parser.add_argument("--deadman-action", choices=DEADMAN_ACTIONS, default=Deadman.action,
                         help="what the machine does then: pause (default), preempt, or none")
+    parser.add_argument("--foxglove", type=int, metavar="PORT",
+                        help="also serve the Foxglove WebSocket protocol on this port (0: a free one), on 127.0.0.1 "
+                             "only (it has no token): each machine's events and active states, the log, the "
+                             "arm's frames")
 
 
 def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
-    """The dashboard's server on ``--host/--port/--token``, started; ``options`` go to ``ServerThread``
-    (``scene_url``, ``show_pose``). Raises CannotServe."""
+    """The dashboard's server on ``--host/--port/--token``, started (and, with ``--foxglove``, the
+    Foxglove server fed from its hub); ``options`` go to ``ServerThread`` (``scene_url``,
+    ``show_pose``). Raises CannotServe."""
     from ..http_server import ServerThread
 
     try:
-        return ServerThread(host=args.host, port=args.port, token=args.token or None,
-                            deadman=Deadman(args.deadman, args.deadman_action), **options).start()
+        srv = ServerThread(host=args.host, port=args.port, token=args.token or None,
+                           deadman=Deadman(args.deadman, args.deadman_action), **options).start()
     except (ValueError, OSError) as exc:
         raise CannotServe(str(exc)) from exc
+    if args.foxglove is not None:
+        from .foxglove_bridge import start_foxglove
+
+        try:
+            start_foxglove(args, srv.hub)
+        except RuntimeError as exc:  # foxglove-sdk's: the port is taken
+            srv.stop()
+            raise CannotServe("the Foxglove server cannot start: %s" % exc) from exc
+    return srv
 
 
 def announce_viewer(args: argparse.Namespace, srv: ServerThread) -> None:

@@ -1,0 +1,57 @@
+"""``--foxglove PORT``: the served machines on the Foxglove WebSocket protocol too
+(interop/foxglove_live.py), fed from the hub as a dashboard's websocket is: each machine's events
+from its feed's ring, on the server's event loop (where the ring changes), and its snapshot when it
+joins or falls further behind than the ring keeps."""
+
+from __future__ import annotations
+
+import argparse
+import asyncio
+import sys
+from typing import TYPE_CHECKING
+
+from fsm.observation.encoding import loads
+
+if TYPE_CHECKING:
+    from interop.foxglove_live import FoxgloveLive
+
+    from ..hub import Hub
+
+LOOPBACK = "127.0.0.1"
+POLL_SECONDS = 0.05
+BATCH = 2000  # events of one machine taken per poll at most
+
+
+def start_foxglove(args: argparse.Namespace, hub: Hub) -> FoxgloveLive:
+    """The Foxglove server on 127.0.0.1 and ``--foxglove``, fed from ``hub`` until the process ends.
+    Foxglove's protocol has no token: it is never served on another address than the loopback,
+    whatever ``--host`` says (reach it from elsewhere through an SSH tunnel)."""
+    from interop.foxglove_live import FoxgloveLive
+
+    from .arm_frames import arm_frames
+
+    live = FoxgloveLive(LOOPBACK, args.foxglove, frames=arm_frames())
+    asyncio.run_coroutine_threadsafe(_pump(hub, live), hub.loop)
+    print("fsmscope: Foxglove WebSocket at ws://%s:%d (no token: this computer only)" % (LOOPBACK, live.port),
+          file=sys.stderr, flush=True)
+    return live
+
+
+async def _pump(hub: Hub, live: FoxgloveLive) -> None:
+    fed: dict[str, int] = {}  # machine -> the seq of the last event fed
+    while True:
+        for entry in hub.machines():
+            last = fed.get(entry.name)
+            lines = entry.encoded_from(last + 1, BATCH) if last is not None else None
+            if lines is None:
+                seq, frame = entry.snapshot()
+                status = loads(frame)["status"]
+                live.event({"kind": "snapshot", "machine": entry.name, "seq": seq, "t": status.get("last_t") or 0.0,
+                            "run": status.get("run"), "path": status.get("root_path") or "", "status": status})
+                fed[entry.name] = seq
+                continue
+            for line in lines:
+                event = loads(line)
+                live.event(event)
+                fed[entry.name] = event["seq"]
+        await asyncio.sleep(POLL_SECONDS)

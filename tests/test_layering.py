@@ -2,7 +2,8 @@
 
 fsm is the runtime: the standard library only (orjson when installed) and nothing of the web or
 the simulator. Inside fsm the core never imports its extensions (ros, logfiles, debugging). sim never imports
-server; server imports sim only in its composition root, the CLI (server/cli/).
+server; interop (bags, MCAP, Foxglove) imports neither; server imports sim and interop only in its
+composition root, the CLI (server/cli/).
 """
 
 from __future__ import annotations
@@ -93,6 +94,18 @@ def test_sim_never_imports_the_server():
 def test_the_server_imports_sim_only_in_the_composition_root():
     wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
              for arrow in imports_of(path, "sim")]
+    assert wrong == []
+
+
+def test_interop_never_imports_the_server_or_the_simulator():
+    wrong = [arrow for path in python_files("interop") for package in ("server", "sim")
+             for arrow in imports_of(path, package)]
+    assert wrong == []
+
+
+def test_the_server_imports_interop_only_in_the_composition_root():
+    wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
+             for arrow in imports_of(path, "interop")]
     assert wrong == []
 
 

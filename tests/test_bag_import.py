@@ -130,3 +130,9 @@ def test_replay_of_a_bag_prints_the_run_and_its_statistics(tmp_path):
     assert done.returncode == 0, done.stderr
     assert "State machine transitioning 'GRASP':'grasped'-->'PLACE'" in done.stdout
     assert "machine pick_place: finished with outcome 'succeeded'" in done.stdout
+
+
+def test_replay_of_a_bag_without_smach_topics_exits_2_and_says_why(tmp_path):
+    bag = write_bag(tmp_path / "other.bag", "ros1", [(t, "/chatter/smach/other", k, f) for t, _, k, f in messages()[:1]])
+    done = cli("replay", bag)
+    assert done.returncode == 2 and "no SMACH introspection topics" in done.stderr

@@ -99,7 +99,8 @@ def test_the_breadcrumb_names_the_container_at_the_view_centre(page):
     root = page.evaluate("window.fsmscope.status.root_path")
     target = container_id(root + "/TASK_1")
     # The drawing of depth 2 (the root and its 3 tasks open), not semantic zoom's, which may have TASK_1 open too.
-    page.wait_for_function("() => document.querySelectorAll('#graph g.cluster').length === 4")
+    page.wait_for_function("(id) => document.querySelectorAll('#graph g.cluster').length === 4"
+                           " && document.getElementById(id) !== null", arg=target)
     centre = "el => { const b = el.getBoundingClientRect(); return [b.x + b.width / 2, b.y + b.height / 2]; }"
     view = page.eval_on_selector("#graph", centre)
     for _ in range(10):  # drags of at most 200 px, the pointer always inside the page, until TASK_1 is at the centre

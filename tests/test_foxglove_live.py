@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 import asyncio
+import concurrent.futures
 import json
 import socket
 import threading
@@ -53,7 +54,9 @@ def test_a_foxglove_client_sees_the_channels_and_the_active_state_change():
         runner = threading.Thread(target=lambda: started.wait(10) and sm.execute(), daemon=True)
         runner.start()
         try:
-            channels, states = asyncio.run(watch(live.port, "/fsmscope/loop/state", started, 10))
+            with concurrent.futures.ThreadPoolExecutor(1) as own_loop:  # the suite's thread may run a loop
+                channels, states = own_loop.submit(asyncio.run, watch(live.port, "/fsmscope/loop/state", started,
+                                                                      10)).result()
         finally:
             live.stop()
         runner.join(10)

@@ -136,3 +136,12 @@ def test_replay_of_a_bag_without_smach_topics_exits_2_and_says_why(tmp_path):
     bag = write_bag(tmp_path / "other.bag", "ros1", [(t, "/chatter/smach/other", k, f) for t, _, k, f in messages()[:1]])
     done = cli("replay", bag)
     assert done.returncode == 2 and "no SMACH introspection topics" in done.stderr
+
+
+def test_a_humble_sqlite3_bag_without_message_definitions_reads_with_ours(tmp_path, noetic_events):
+    import sqlite3
+
+    bag = write_bag(tmp_path / "humble", "ros2-sqlite3")
+    with sqlite3.connect(next(bag.glob("*.db3"))) as db:  # Humble's rosbag2 stored no definitions
+        db.execute("DELETE FROM message_definitions")
+    assert events_of(bag) == noetic_events

@@ -1,0 +1,26 @@
+"""A Zenoh session's configuration from what a user says: peer mode (the default) or client of a
+router, explicit endpoints to listen on and connect to, and multicast scouting (LAN discovery) only
+when asked: by default a session finds nobody it was not told about."""
+
+from __future__ import annotations
+
+import json
+from typing import Sequence
+
+import zenoh
+
+
+def session_config(connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
+                   scouting: bool = False) -> zenoh.Config:
+    """``connect`` / ``listen``: endpoints such as ``tcp/127.0.0.1:7447``; ``mode``: "peer" or
+    "client" (through a zenohd router); ``scouting``: find peers on the LAN by multicast."""
+    if mode not in ("peer", "client"):
+        raise ValueError("mode must be peer or client, not %r" % mode)
+    config = zenoh.Config()
+    config.insert_json5("mode", json.dumps(mode))
+    config.insert_json5("scouting/multicast/enabled", json.dumps(scouting))
+    if connect:
+        config.insert_json5("connect/endpoints", json.dumps(list(connect)))
+    if listen:
+        config.insert_json5("listen/endpoints", json.dumps(list(listen)))
+    return config

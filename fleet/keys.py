@@ -1,0 +1,45 @@
+"""The fleet's key space on Zenoh: ``fsmscope/<robot>/<machine>/...``. Robot and machine names are
+single key chunks: characters Zenoh gives a meaning to (``/ * $ ? #``) are refused."""
+
+from __future__ import annotations
+
+PREFIX = "fsmscope"
+_RESERVED = set("/*$?#")
+
+
+def chunk(name: str, what: str) -> str:
+    """``name`` as one chunk of a key; ValueError when it cannot be one."""
+    if not name or _RESERVED & set(name) or name != name.strip():
+        raise ValueError("a %s's name must be a non-empty key chunk without / * $ ? # or outer spaces: %r"
+                         % (what, name))
+    return name
+
+
+def machine_key(robot: str, machine: str) -> str:
+    """The machine's own key: its liveliness token (alive while its process is)."""
+    return "%s/%s/%s" % (PREFIX, chunk(robot, "robot"), chunk(machine, "machine"))
+
+
+def events_key(robot: str, machine: str) -> str:
+    """Where the machine's events are put, in batches (a JSON list)."""
+    return machine_key(robot, machine) + "/events"
+
+
+def state_key(robot: str, machine: str) -> str:
+    """The queryable that answers the machine's snapshot event (its whole state now)."""
+    return machine_key(robot, machine) + "/state"
+
+
+def history_key(robot: str, machine: str) -> str:
+    """The queryable that answers ``?since=SEQ`` with the events from SEQ on that the robot keeps."""
+    return machine_key(robot, machine) + "/history"
+
+
+ALL_MACHINES = PREFIX + "/*/*"
+ALL_EVENTS = PREFIX + "/*/*/events"
+
+
+def split(key: str) -> tuple[str, str]:
+    """(robot, machine) of any of a machine's keys."""
+    parts = key.split("/")
+    return parts[1], parts[2]

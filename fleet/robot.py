@@ -1,0 +1,165 @@
+"""A robot's machines on Zenoh, with one call:
+
+    from fleet.robot import ZenohRobot
+    fsm.attach(sm, ZenohRobot("r1", connect=["tcp/192.168.1.10:7447"]), name="picker")
+
+The observer only appends to a bounded buffer (the machine's thread never waits for the network).
+A background thread applies the events to its own ``Status`` per machine, keeps the newest
+``RING`` of them, and puts them in batches on ``fsmscope/<robot>/<machine>/events``. Per machine
+it also declares, on the machine's first event:
+
+- a liveliness token on ``fsmscope/<robot>/<machine>``: dashboards see the machine appear, and
+  see it gone within Zenoh's lease when the process dies or drops off the network;
+- a queryable ``.../state``: the machine's snapshot event (its whole state now), for a dashboard
+  that joins late;
+- a queryable ``.../history?since=SEQ``: the events from SEQ on that the ring still holds (a
+  dashboard whose connection dropped fills its gap; older than the ring: it takes the snapshot).
+
+When nobody listens or the network is gone, puts go nowhere and the machine runs on; memory stays
+bounded by the buffer and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
+"""
+
+from __future__ import annotations
+
+import collections
+import threading
+import time
+from typing import Any, Sequence
+
+import zenoh
+
+from fsm.observation import closing, schema
+from fsm.observation.encoding import dumps
+from fsm.observation.status import Status
+
+from . import keys
+from .config import session_config
+
+BUFFER = 100_000  # events waiting for the sender before the oldest are dropped
+RING = 10_000  # events of each machine kept for history queries
+MAX_BATCH = 2000  # events per put
+
+
+class _Machine:
+    """What the robot keeps of one machine, and its Zenoh entities."""
+
+    def __init__(self, session: zenoh.Session, robot: str, name: str) -> None:
+        self.status = Status(name)
+        self.ring: collections.deque[dict] = collections.deque(maxlen=RING)
+        self.lock = threading.Lock()  # queries come from Zenoh's threads
+        self.publisher = session.declare_publisher(keys.events_key(robot, name),
+                                                   congestion_control=zenoh.CongestionControl.DROP)
+        self.token = session.liveliness().declare_token(keys.machine_key(robot, name))
+        self.state = session.declare_queryable(keys.state_key(robot, name), self._state)
+        self.history = session.declare_queryable(keys.history_key(robot, name), self._history)
+
+    def _state(self, query: zenoh.Query) -> None:
+        with self.lock:
+            status = self.status
+            snapshot = schema.event(status.last_seq, time.time(), status.run, status.machine, "snapshot",
+                                    status.root_path or "/SM_ROOT", {"status": status.to_dict()})
+        query.reply(query.key_expr, dumps(snapshot))
+
+    def _history(self, query: zenoh.Query) -> None:
+        try:
+            since = int(query.parameters.get("since") or 0)
+        except ValueError:
+            query.reply_err(b"since must be an integer")
+            return
+        with self.lock:
+            kept = list(self.ring)
+        first = kept[0]["seq"] if kept else None
+        events = [e for e in kept if e["seq"] >= since]
+        query.reply(query.key_expr, dumps({"complete": first is not None and first <= since, "events": events}))
+
+    def close(self) -> None:
+        for entity in (self.history, self.state, self.token, self.publisher):
+            entity.undeclare()
+
+
+class ZenohRobot:
+    """An observer (``fsm.attach(sm, ZenohRobot("r1", ...))``) that puts a robot's machines on Zenoh.
+    ``connect`` / ``listen``: Zenoh endpoints (``tcp/HOST:PORT``); ``mode``: "peer" or "client";
+    ``scouting``: multicast discovery on the LAN (off unless asked)."""
+
+    def __init__(self, robot: str, connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
+                 scouting: bool = False, buffer: int = BUFFER) -> None:
+        self.robot = keys.chunk(robot, "robot")
+        self.session = zenoh.open(session_config(connect, listen, mode, scouting))
+        self._buf: collections.deque[dict] = collections.deque(maxlen=buffer)
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._machines: dict[str, _Machine] = {}
+        self.sent = 0
+        self.dropped = 0
+        self._busy = False
+        self._thread = threading.Thread(target=self._run, name="fsmscope-zenoh", daemon=True)
+        self._thread.start()
+        closing.close_at_exit(self)
+
+    # The observer: runs in the machine's thread.
+    def __call__(self, event: dict) -> None:
+        buf = self._buf
+        if len(buf) == buf.maxlen:
+            self.dropped += 1
+        buf.append(event)
+        if not self._wake.is_set():
+            self._wake.set()
+
+    def flush(self, timeout: float = 5.0) -> bool:
+        """Wait until every buffered event was put; False on timeout."""
+        deadline = time.monotonic() + timeout
+        while (self._buf or self._busy) and time.monotonic() < deadline:
+            time.sleep(0.005)
+        return not self._buf
+
+    def close(self, timeout: float = 5.0) -> None:
+        """Put what is buffered, then leave the network (the machines' tokens go: dashboards see them
+        gone). Idempotent."""
+        if self._stop.is_set():
+            return
+        self.flush(timeout)
+        self._stop.set()
+        self._wake.set()
+        if self._thread is not threading.current_thread():
+            self._thread.join(timeout)
+        for machine in self._machines.values():
+            machine.close()
+        self.session.close()
+        closing.closed(self)
+
+    def __enter__(self) -> ZenohRobot:
+        return self
+
+    def __exit__(self, *exc: Any) -> None:
+        self.close()
+
+    def _run(self) -> None:
+        while not self._stop.is_set():
+            self._wake.wait(0.5)
+            self._wake.clear()
+            while self._buf:
+                self._busy = True
+                self._send(self._take())
+            self._busy = False
+
+    def _take(self) -> dict[str, list[dict]]:
+        batches: dict[str, list[dict]] = {}
+        taken = 0
+        while self._buf and taken < MAX_BATCH:
+            event = self._buf.popleft()
+            batches.setdefault(event["machine"], []).append(event)
+            taken += 1
+        return batches
+
+    def _send(self, batches: dict[str, list[dict]]) -> None:
+        for name, events in batches.items():
+            machine = self._machines.get(name)
+            if machine is None:
+                machine = self._machines[name] = _Machine(self.session, self.robot, keys.chunk(name, "machine"))
+            with machine.lock:
+                for event in events:
+                    machine.status.apply(event)
+                    machine.ring.append(event)
+            machine.publisher.put(dumps(events))
+            self.sent += len(events)

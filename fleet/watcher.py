@@ -1,0 +1,161 @@
+"""A dashboard's side of the fleet: every robot's machines discovered on Zenoh and followed without a
+gap, whenever the dashboard joins and however often the network drops.
+
+A machine is found by its liveliness token (``fsmscope/<robot>/<machine>``, with Zenoh's history:
+those alive before the dashboard came too). On finding one the watcher asks its ``.../state``
+(a snapshot event) and delivers it; then it delivers the machine's events from ``.../events`` in
+seq order. An event beyond the next one expected (batches were lost while the network was down)
+makes it ask ``.../history?since=`` for the missing ones first; when the robot no longer keeps
+them, it takes a new snapshot instead. A token withdrawn (the robot's process ended, or dropped off
+the network past Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine.
+
+Each delivered event carries the dashboard's name of the machine, ``<robot>:<machine>``: machines
+of different robots may share a name. Two threads read Zenoh's channels and queue what arrived (a
+bounded queue: a batch that finds it full is dropped, and filled from history after); one thread of
+the watcher's handles the queue in order, asks the queries and delivers.
+"""
+
+from __future__ import annotations
+
+import queue
+import threading
+from typing import Callable, Sequence
+
+import zenoh
+
+from fsm.observation import closing
+from fsm.observation.encoding import loads
+
+from . import keys
+from .config import session_config
+
+QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
+QUEUE = 10_000  # samples waiting for the watcher's thread before new ones are dropped
+
+
+def fleet_name(robot: str, machine: str) -> str:
+    """The dashboard's name of a robot's machine."""
+    return "%s:%s" % (robot, machine)
+
+
+class FleetWatcher:
+    """Follows every machine of the fleet: ``deliver(event)`` for each snapshot and event (renamed),
+    ``alive(name, bool)`` as machines come and go."""
+
+    def __init__(self, deliver: Callable[[dict], None], alive: Callable[[str, bool], None],
+                 connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
+                 scouting: bool = False) -> None:
+        self.deliver = deliver
+        self.alive = alive
+        self.session = zenoh.open(session_config(connect, listen, mode, scouting))
+        self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
+        self._queue: queue.Queue[tuple[str, str, bytes | bool] | None] = queue.Queue(QUEUE)
+        self.gaps_filled = 0
+        self.snapshots = 0
+        self.dropped = 0  # batches that found the queue full
+        self._thread = threading.Thread(target=self._work, name="fsmscope-fleet", daemon=True)
+        self._thread.start()
+        # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
+        # process from ending); the events' channel drops the oldest when full (the gap is filled after).
+        self._events = self.session.declare_subscriber(keys.ALL_EVENTS, zenoh.handlers.RingChannel(QUEUE))
+        self._tokens = self.session.liveliness().declare_subscriber(keys.ALL_MACHINES, zenoh.handlers.FifoChannel(QUEUE),
+                                                                   history=True)
+        for name, subscriber, read in (("events", self._events, self._on_events), ("tokens", self._tokens, self._on_token)):
+            threading.Thread(target=self._read, args=(subscriber, read), name="fsmscope-fleet-" + name,
+                             daemon=True).start()
+        closing.close_at_exit(self)
+
+    def close(self) -> None:
+        if self._closed:
+            return
+        self._closed = True
+        self._tokens.undeclare()
+        self._events.undeclare()
+        self._queue.put(None)
+        self._thread.join(QUERY_TIMEOUT)
+        self.session.close()
+        closing.closed(self)
+
+    _closed = False
+
+    @staticmethod
+    def _read(subscriber: zenoh.Subscriber, handle: Callable[[zenoh.Sample], None]) -> None:
+        try:
+            for sample in subscriber:
+                handle(sample)
+        except zenoh.ZError:  # the session closed
+            pass
+
+    # The readers' threads: queue, never wait.
+    def _on_token(self, sample: zenoh.Sample) -> None:
+        robot, machine = keys.split(str(sample.key_expr))
+        self._put(robot, machine, sample.kind == zenoh.SampleKind.PUT)
+
+    def _on_events(self, sample: zenoh.Sample) -> None:
+        robot, machine = keys.split(str(sample.key_expr))
+        self._put(robot, machine, sample.payload.to_bytes())
+
+    def _put(self, robot: str, machine: str, what: bytes | bool) -> None:
+        try:
+            self._queue.put_nowait((robot, machine, what))
+        except queue.Full:
+            self.dropped += 1  # a token change is dropped only with the queue full of batches
+
+    # The watcher's thread.
+    def _work(self) -> None:
+        while True:
+            item = self._queue.get()
+            if item is None:
+                return
+            robot, machine, what = item
+            name = fleet_name(robot, machine)
+            if what is True:
+                self.alive(name, True)
+                if name not in self._last:
+                    self._snapshot(robot, machine)
+                else:
+                    self._fill(robot, machine, self._last[name] + 1)  # back after a drop: what it missed
+            elif what is False:
+                self.alive(name, False)
+            elif name in self._last:  # events of a machine not joined yet: its snapshot comes with its token
+                events = loads(what)
+                if events and events[0]["seq"] > self._last[name] + 1:
+                    self._fill(robot, machine, self._last[name] + 1)
+                self._deliver(name, events)
+
+    def _deliver(self, name: str, events: list[dict]) -> None:
+        last = self._last.get(name, 0)
+        for event in events:
+            if event["seq"] <= last:
+                continue  # delivered already (a history answer and a batch overlap)
+            event["machine"] = name
+            self.deliver(event)
+            last = event["seq"]
+        self._last[name] = last
+
+    def _snapshot(self, robot: str, machine: str) -> None:
+        for reply in self.session.get(keys.state_key(robot, machine), timeout=QUERY_TIMEOUT):
+            if reply.ok is None:
+                continue
+            snapshot = loads(reply.ok.payload.to_bytes())
+            name = fleet_name(robot, machine)
+            snapshot["machine"] = name
+            snapshot["status"]["machine"] = name
+            self.deliver(snapshot)
+            self._last[name] = snapshot["seq"]
+            self.snapshots += 1
+            return
+
+    def _fill(self, robot: str, machine: str, since: int) -> None:
+        """The events from ``since`` on, from the robot's history; a snapshot when it no longer has them."""
+        name = fleet_name(robot, machine)
+        for reply in self.session.get(keys.history_key(robot, machine) + "?since=%d" % since, timeout=QUERY_TIMEOUT):
+            if reply.ok is None:
+                continue
+            answer = loads(reply.ok.payload.to_bytes())
+            if not answer["complete"]:
+                self._snapshot(robot, machine)
+                return
+            self._deliver(name, answer["events"])
+            self.gaps_filled += 1
+            return

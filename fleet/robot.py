@@ -49,9 +49,9 @@ class _Machine:
         self.lock = threading.Lock()  # queries come from Zenoh's threads
         self.publisher = session.declare_publisher(keys.events_key(robot, name),
                                                    congestion_control=zenoh.CongestionControl.DROP)
-        self.token = session.liveliness().declare_token(keys.machine_key(robot, name))
         self.state = session.declare_queryable(keys.state_key(robot, name), self._state)
         self.history = session.declare_queryable(keys.history_key(robot, name), self._history)
+        self.token = session.liveliness().declare_token(keys.machine_key(robot, name))  # last: all is there
 
     def _state(self, query: zenoh.Query) -> None:
         with self.lock:
@@ -73,7 +73,7 @@ class _Machine:
         query.reply(query.key_expr, dumps({"complete": first is not None and first <= since, "events": events}))
 
     def close(self) -> None:
-        for entity in (self.history, self.state, self.token, self.publisher):
+        for entity in (self.token, self.history, self.state, self.publisher):
             entity.undeclare()
 
 

@@ -117,7 +117,9 @@ class FleetWatcher:
                     self._fill(robot, machine, self._last[name] + 1)  # back after a drop: what it missed
             elif what is False:
                 self.alive(name, False)
-            elif name in self._last:  # events of a machine not joined yet: its snapshot comes with its token
+            elif name not in self._last:  # not joined: its state did not answer yet (Zenoh had not told it)
+                self._snapshot(robot, machine)
+            else:
                 events = loads(what)
                 if events and events[0]["seq"] > self._last[name] + 1:
                     self._fill(robot, machine, self._last[name] + 1)

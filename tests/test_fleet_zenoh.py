@@ -1,0 +1,135 @@
+"""The fleet over real Zenoh sessions on the loopback (explicit tcp endpoints, multicast scouting
+off): a robot's machine reaches a dashboard's watcher as a snapshot and then every event, whenever
+the dashboard joins; a robot that leaves is seen gone and seen back; a connection cut and restored
+while the machine runs leaves no gap."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import fsm
+import pytest
+from fleet_support import Proxy, free_endpoint, slow_loop
+
+from fleet.robot import ZenohRobot
+from fleet.watcher import FleetWatcher
+from fsm.observation.status import Status
+from server.testing.polling import wait_for
+
+
+class Dashboard:
+    """What a watcher delivered: the events, in order, and each machine's comings and goings."""
+
+    def __init__(self, **session) -> None:
+        self.events: list[dict] = []
+        self.alive: list[tuple[str, bool]] = []
+        self.watcher = FleetWatcher(self.events.append, lambda name, up: self.alive.append((name, up)), **session)
+
+    def status(self, name: str) -> Status:
+        """The machine's state rebuilt from what was delivered (a snapshot, then events)."""
+        status = Status(name)
+        for event in self.events:
+            if event["machine"] == name:
+                status.apply(event)
+        return status
+
+
+@pytest.fixture
+def quiet():
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+
+
+def run_on(robot: ZenohRobot, sm, name: str = "loop") -> list[dict]:
+    """Run ``sm`` published by ``robot``; the events it emitted, as the robot's own log has them."""
+    own = []
+    fsm.attach(sm, robot, name=name)
+    fsm.attach(sm, own.append)
+    sm.execute()
+    robot.flush()
+    return own
+
+
+def own_status(events: list[dict]) -> dict:
+    status = Status("loop")
+    for event in events:
+        status.apply(event)
+    return status.to_dict()
+
+
+def test_a_dashboard_there_first_gets_a_snapshot_then_every_event_in_order(quiet):
+    endpoint = free_endpoint()
+    dash = Dashboard(listen=[endpoint])
+    robot = ZenohRobot("r1", connect=[endpoint])
+    try:
+        own = run_on(robot, slow_loop(60))
+        wait_for(lambda: dash.events and dash.events[-1]["seq"] == own[-1]["seq"], 10,
+                 what=lambda: "the last event (%d) delivered: %r, alive %r" % (
+                     own[-1]["seq"], [(e["kind"], e["seq"]) for e in dash.events[-3:]], dash.alive))
+        snapshot, *events = dash.events
+        assert snapshot["kind"] == "snapshot" and snapshot["machine"] == "r1:loop"
+        assert [e["seq"] for e in events] == [e["seq"] for e in own if e["seq"] > snapshot["seq"]]
+        assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
+    finally:
+        robot.close()
+        dash.watcher.close()
+
+
+def test_a_dashboard_that_joins_after_the_run_gets_its_end_as_a_snapshot(quiet):
+    endpoint = free_endpoint()
+    robot = ZenohRobot("r1", listen=[endpoint])
+    try:
+        own = run_on(robot, slow_loop(10, 0.0))
+        dash = Dashboard(connect=[endpoint])
+        try:
+            wait_for(lambda: dash.events, 10, what="a snapshot")
+            assert [e["kind"] for e in dash.events] == ["snapshot"] and dash.events[0]["seq"] == own[-1]["seq"]
+            assert dash.events[0]["status"]["outcome"] == "done"
+        finally:
+            dash.watcher.close()
+    finally:
+        robot.close()
+
+
+def test_a_robot_that_leaves_is_seen_gone_and_seen_back(quiet):
+    endpoint = free_endpoint()
+    dash = Dashboard(listen=[endpoint])
+    try:
+        robot = ZenohRobot("r1", connect=[endpoint])
+        run_on(robot, slow_loop(4, 0.0))
+        wait_for(lambda: ("r1:loop", True) in dash.alive, 10, what="the machine seen")
+        robot.close()
+        wait_for(lambda: dash.alive[-1] == ("r1:loop", False), 10, what="the machine seen gone")
+        again = ZenohRobot("r1", connect=[endpoint])
+        try:
+            run_on(again, slow_loop(4, 0.0))
+            wait_for(lambda: dash.alive[-1] == ("r1:loop", True), 10, what="the machine seen back")
+        finally:
+            again.close()
+    finally:
+        dash.watcher.close()
+
+
+def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quiet):
+    endpoint = free_endpoint()
+    dash = Dashboard(listen=[endpoint])
+    proxy = Proxy(endpoint)
+    robot = ZenohRobot("r1", connect=[proxy.endpoint])
+    try:
+        sm = slow_loop(300, 0.01)
+        own: list[dict] = []
+        runner = threading.Thread(target=lambda: own.extend(run_on(robot, sm)), daemon=True)
+        runner.start()
+        wait_for(lambda: len(dash.events) > 20, 10, what="events before the cut")
+        proxy.cut()
+        time.sleep(1.0)  # the machine runs on, unseen
+        proxy.restore()
+        runner.join(30)
+        wait_for(lambda: dash.events[-1]["seq"] == own[-1]["seq"], 20, what="the last event after the cut")
+        first = dash.events[0]["seq"]
+        assert [e["seq"] for e in dash.events[1:]] == [e["seq"] for e in own if e["seq"] > first]
+        assert dash.watcher.gaps_filled + dash.watcher.snapshots > 1  # it did miss events, and got them back
+    finally:
+        robot.close()
+        proxy.close()
+        dash.watcher.close()

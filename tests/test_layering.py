@@ -2,8 +2,8 @@
 
 fsm is the runtime: the standard library only (orjson when installed) and nothing of the web or
 the simulator. Inside fsm the core never imports its extensions (ros, logfiles, debugging). sim never imports
-server; interop (bags, MCAP, Foxglove) imports neither; server imports sim and interop only in its
-composition root, the CLI (server/cli/).
+server; interop (bags, MCAP, Foxglove) and fleet (Zenoh) import neither; server imports sim, interop
+and fleet only in its composition root, the CLI (server/cli/).
 """
 
 from __future__ import annotations
@@ -106,6 +106,18 @@ def test_interop_never_imports_the_server_or_the_simulator():
 def test_the_server_imports_interop_only_in_the_composition_root():
     wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
              for arrow in imports_of(path, "interop")]
+    assert wrong == []
+
+
+def test_fleet_never_imports_the_server_the_simulator_or_interop():
+    wrong = [arrow for path in python_files("fleet") for package in ("server", "sim", "interop")
+             for arrow in imports_of(path, package)]
+    assert wrong == []
+
+
+def test_the_server_imports_fleet_only_in_the_composition_root():
+    wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
+             for arrow in imports_of(path, "fleet")]
     assert wrong == []
 
 

@@ -1,11 +1,13 @@
 """``fsmscope serve``: a standalone dashboard that machines of other processes publish to
-(``server.publisher.Publisher`` posting to /api/ingest)."""
+(``server.publisher.Publisher`` posting to /api/ingest), and, with ``--zenoh``, that follows the
+fleet's robots on Zenoh (fleet_bridge.py)."""
 
 from __future__ import annotations
 
 import argparse
 import sys
 
+from .fleet_bridge import add_zenoh_arguments
 from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 HELP = "serve the dashboard for machines of other processes (they publish to /api/ingest)"
@@ -15,10 +17,15 @@ DEFAULT_PORT = 8765
 
 def arguments(parser: argparse.ArgumentParser) -> None:
     add_server_arguments(parser, DEFAULT_PORT)
+    add_zenoh_arguments(parser)
 
 
 def main(args: argparse.Namespace) -> int:
     srv = start_server(args)
+    if args.zenoh is not None:
+        from .fleet_bridge import start_fleet
+
+        start_fleet(args, srv.hub)
     print("fsmscope: serving the dashboard at %s" % srv.url, file=sys.stderr)
     announce_viewer(args, srv)
     print("fsmscope: other processes publish with server.publisher.Publisher(%r, %r); Ctrl-C stops"

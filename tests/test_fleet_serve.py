@@ -1,0 +1,51 @@
+"""`fsmscope serve --zenoh` in a real process follows a robot's machine published on Zenoh (a real
+session on the loopback): the machine appears in /api/machines with the robot's state, and is shown
+disconnected when the robot leaves."""
+
+from __future__ import annotations
+
+import os
+import re
+import signal
+import subprocess
+import sys
+
+import fsm
+import httpx
+from fleet_support import free_endpoint, slow_loop
+
+from fleet.robot import ZenohRobot
+from server.testing.polling import wait_for
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leaves():
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    endpoint = free_endpoint()
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
+                             "--zenoh-listen", endpoint], cwd=ROOT, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True)
+    try:
+        for line in proc.stderr:
+            found = re.search(r"serving the dashboard at (http://\S+)", line)
+            if found:
+                break
+        url = found.group(1)
+        base, token = url.split("/?token=")
+        machines = lambda: {m["name"]: m for m in httpx.get(base + "/api/machines", params={"token": token}).json()}
+        robot = ZenohRobot("r1", connect=[endpoint])
+        own = []
+        sm = slow_loop(40)
+        fsm.attach(sm, robot, name="loop")
+        fsm.attach(sm, own.append)
+        sm.execute()
+        robot.flush()
+        wait_for(lambda: machines().get("r1:loop", {}).get("last_seq") == own[-1]["seq"], 15,
+                 what=lambda: "r1:loop at seq %d: %r" % (own[-1]["seq"], machines()))
+        assert machines()["r1:loop"]["connected"] is True
+        robot.close()
+        wait_for(lambda: machines()["r1:loop"]["connected"] is False, 15, what="r1:loop shown gone")
+    finally:
+        os.killpg(proc.pid, signal.SIGINT)
+        proc.wait(20)

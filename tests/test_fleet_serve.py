@@ -15,6 +15,9 @@ import httpx
 from fleet_support import free_endpoint, slow_loop
 
 from fleet.robot import ZenohRobot
+from fleet.watcher import FleetWatcher
+from fsm.logfiles.log_reader import read_events
+from server.cli.demo import MACHINE_NAME
 from server.testing.polling import wait_for
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -49,3 +52,51 @@ def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leav
     finally:
         os.killpg(proc.pid, signal.SIGINT)
         proc.wait(20)
+
+
+def test_the_demo_published_with_zenoh_reaches_a_dashboard_to_its_last_event(tmp_path):
+    endpoint = free_endpoint()
+    seen = []
+    watcher = FleetWatcher(seen.append, lambda name, up: None, listen=[endpoint])
+    try:
+        log = tmp_path / "demo.jsonl"
+        done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1", "--fast",
+                               "--record", str(log), "--zenoh", "lab1", "--zenoh-connect", endpoint],
+                              cwd=ROOT, capture_output=True, text=True, timeout=120)
+        assert done.returncode == 0, done.stderr
+        last = max(e["seq"] for e in read_events(str(log)) if e["kind"] != "snapshot")
+        wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what=lambda: "event %d, at %r" % (
+            last, seen[-1]["seq"] if seen else None))
+        assert {e["machine"] for e in seen} == {"lab1:" + MACHINE_NAME}
+    finally:
+        watcher.close()
+
+
+SCRIPT = """
+import time
+import fsm
+sm = fsm.StateMachine(["done"])
+with sm:
+    fsm.StateMachine.add("A", fsm.CBState(lambda ud: time.sleep(0.01) or "go", outcomes=["go"]), {"go": "B"})
+    fsm.StateMachine.add("B", fsm.CBState(lambda ud: time.sleep(0.01) or "go", outcomes=["go"]), {"go": "done"})
+sm.execute()
+"""
+
+
+def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_path):
+    endpoint = free_endpoint()
+    seen = []
+    watcher = FleetWatcher(seen.append, lambda name, up: None, listen=[endpoint])
+    try:
+        script = tmp_path / "pick.py"
+        script.write_text(SCRIPT)
+        log = tmp_path / "pick.jsonl"
+        done = subprocess.run([sys.executable, "-m", "server.cli", "run", str(script), "--no-serve", "--record",
+                               str(log), "--zenoh", "arm2", "--zenoh-connect", endpoint],
+                              cwd=ROOT, capture_output=True, text=True, timeout=60)
+        assert done.returncode == 0, done.stderr
+        last = max(e["seq"] for e in read_events(str(log)) if e["kind"] != "snapshot")
+        wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
+        assert {e["machine"] for e in seen} == {"arm2:pick"}
+    finally:
+        watcher.close()

@@ -17,6 +17,7 @@ import threading
 import time
 from typing import Any
 
+from .fleet_bridge import add_zenoh_arguments, zenoh_robot
 from .serving import add_server_arguments, announce_viewer, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"
@@ -33,6 +34,7 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     parser.add_argument("--fast", action="store_true", help="physics as fast as possible, not real time")
     add_server_arguments(parser, 0)
+    add_zenoh_arguments(parser, publish=True)
     parser.add_argument("--verbose", action="store_true", help="print the machine's info/debug log")
 
 
@@ -67,6 +69,9 @@ def main(args: argparse.Namespace) -> int:
     machine = demo.build_machine()
     recorder = Recorder(record_path)
     rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
+    robot = zenoh_robot(args)
+    if robot is not None:
+        fsm.attach(machine, robot, name=MACHINE_NAME)
 
     def record_pose(fields: dict) -> bool:
         if rep.run is None:  # not started yet: a log opens with the machine's structure

@@ -7,6 +7,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING
 
+from .fleet_bridge import add_zenoh_arguments, zenoh_robot
 from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
@@ -27,12 +28,18 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--exit", action="store_true",
                         help="exit when the script ends instead of keeping the dashboard up")
     add_server_arguments(parser, 0)
+    add_zenoh_arguments(parser, publish=True)
 
 
 def main(args: argparse.Namespace) -> int:
+    import fsm
+
     from ..runner import Runner
 
     runner = Runner(args.script, list(args.extra), args.record)
+    robot = zenoh_robot(args)
+    if robot is not None:
+        runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
     if args.no_serve:
         return runner.run()
     return run_with_dashboard(args, runner)

@@ -17,7 +17,7 @@ DEFAULT_PORT = 8765
 
 def arguments(parser: argparse.ArgumentParser) -> None:
     add_server_arguments(parser, DEFAULT_PORT)
-    add_zenoh_arguments(parser)
+    add_zenoh_arguments(parser, publish=False)
 
 
 def main(args: argparse.Namespace) -> int:

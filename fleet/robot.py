@@ -30,6 +30,7 @@ import zenoh
 
 from fsm.observation import closing, schema
 from fsm.observation.encoding import dumps
+from fsm.observation.handoff import Handoff
 from fsm.observation.status import Status
 
 from . import keys
@@ -86,32 +87,27 @@ class ZenohRobot:
                  scouting: bool = False, buffer: int = BUFFER) -> None:
         self.robot = keys.chunk(robot, "robot")
         self.session = zenoh.open(session_config(connect, listen, mode, scouting))
-        self._buf: collections.deque[dict] = collections.deque(maxlen=buffer)
-        self._wake = threading.Event()
+        self._handoff = Handoff(buffer)
+        self._buf = self._handoff.events
         self._stop = threading.Event()
         self._machines: dict[str, _Machine] = {}
         self.sent = 0
-        self.dropped = 0
-        self._busy = False
         self._thread = threading.Thread(target=self._run, name="fsmscope-zenoh", daemon=True)
         self._thread.start()
         closing.close_at_exit(self)
 
     # The observer: runs in the machine's thread.
     def __call__(self, event: dict) -> None:
-        buf = self._buf
-        if len(buf) == buf.maxlen:
-            self.dropped += 1
-        buf.append(event)
-        if not self._wake.is_set():
-            self._wake.set()
+        self._handoff(event)
+
+    @property
+    def dropped(self) -> int:
+        """Events dropped because the buffer was full."""
+        return self._handoff.dropped
 
     def flush(self, timeout: float = 5.0) -> bool:
         """Wait until every buffered event was put; False on timeout."""
-        deadline = time.monotonic() + timeout
-        while (self._buf or self._busy) and time.monotonic() < deadline:
-            time.sleep(0.005)
-        return not self._buf
+        return self._handoff.drained(timeout)
 
     def close(self, timeout: float = 5.0) -> None:
         """Put what is buffered, then leave the network (the machines' tokens go: dashboards see them
@@ -120,7 +116,7 @@ class ZenohRobot:
             return
         self.flush(timeout)
         self._stop.set()
-        self._wake.set()
+        self._handoff.wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join(timeout)
         for machine in self._machines.values():
@@ -135,13 +131,14 @@ class ZenohRobot:
         self.close()
 
     def _run(self) -> None:
+        wake = self._handoff.wake
         while not self._stop.is_set():
-            self._wake.wait(0.5)
-            self._wake.clear()
+            wake.wait(0.5)
+            wake.clear()
             while self._buf:
-                self._busy = True
+                self._handoff.busy = True
                 self._send(self._take())
-            self._busy = False
+            self._handoff.busy = False
 
     def _take(self) -> dict[str, list[dict]]:
         batches: dict[str, list[dict]] = {}

@@ -37,6 +37,7 @@ from typing import Any
 
 from fsm.observation import closing, introspection, schema
 from fsm.observation.encoding import dumps, loads
+from fsm.observation.handoff import Handoff
 from fsm.observation.status import Status
 
 from .local_control import MachineHandle
@@ -68,8 +69,9 @@ class Publisher:
                  start: bool = True, can_start: bool = False) -> None:
         self.url = ingest_url(url, token)
         self.can_start = can_start
-        self._buf: collections.deque[dict] = collections.deque(maxlen=buffer)
-        self._wake = threading.Event()
+        self._handoff = Handoff(buffer)
+        self._buf = self._handoff.events
+        self._wake = self._handoff.wake
         self._stop = threading.Event()
         self._statuses: dict[str, Status] = {}
         self._backoff_max = backoff_max
@@ -85,7 +87,6 @@ class Publisher:
         self.connected = threading.Event()
         self.sent = 0
         self.connects = 0
-        self.dropped = 0
         self.rejected = 0  # events the server refused (see stderr for why)
         self._thread: threading.Thread | None = None
         closing.close_at_exit(self)
@@ -94,12 +95,12 @@ class Publisher:
 
     # The observer: runs in the machine's thread.
     def __call__(self, event: dict) -> None:
-        buf = self._buf
-        if len(buf) == buf.maxlen:
-            self.dropped += 1
-        buf.append(event)
-        if not self._wake.is_set():
-            self._wake.set()
+        self._handoff(event)
+
+    @property
+    def dropped(self) -> int:
+        """Events dropped because the buffer was full (the server was away too long)."""
+        return self._handoff.dropped
 
     def attached(self, reporter: introspection.Reporter) -> None:
         """``fsm.attach`` gave this publisher a machine (Reporter.add_observer): it takes controls from now on."""
@@ -129,18 +130,13 @@ class Publisher:
 
     def flush(self, timeout: float = 5.0) -> bool:
         """Wait until every buffered event was handed to the socket; False on timeout."""
-        deadline = time.monotonic() + timeout
-        while (self._buf or self._busy) and time.monotonic() < deadline:
-            time.sleep(0.005)
-        return not self._buf
+        return self._handoff.drained(timeout)
 
     def __enter__(self) -> Publisher:
         return self
 
     def __exit__(self, *exc: Any) -> None:
         self.close()
-
-    _busy = False
 
     # The sender thread.
     def _take(self) -> list[dict]:
@@ -197,7 +193,7 @@ class Publisher:
             self._worker.start()
         try:
             with ws:
-                self._busy = True
+                self._handoff.busy = True
                 ws.send(self._hello())
                 snapshots = self._snapshots()
                 if snapshots:
@@ -215,15 +211,15 @@ class Publisher:
                         self._send_answers(ws, connection, every=False)
                         continue
                     self._send_answers(ws, connection, every=True)
-                    self._busy = False
+                    self._handoff.busy = False
                     self._wake.clear()
                     if not self._buf and not self._answers:
                         self._wake.wait(0.5)
-                    self._busy = True
+                    self._handoff.busy = True
         except Exception:
             pass  # the server went away: reconnect
         finally:
-            self._busy = False
+            self._handoff.busy = False
             self.connected.clear()
 
     def _send_answers(self, ws: Any, connection: int, every: bool) -> None:

@@ -12,6 +12,7 @@ import sys
 
 import fsm
 import httpx
+import pytest
 from fleet_support import free_endpoint, slow_loop
 
 from fleet.robot import ZenohRobot
@@ -54,22 +55,31 @@ def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leav
         proc.wait(20)
 
 
-def test_the_demo_published_with_zenoh_reaches_a_dashboard_to_its_last_event(tmp_path):
+@pytest.fixture
+def watching():
+    """(the endpoint a watcher listens on, the events it delivers)."""
     endpoint = free_endpoint()
-    seen = []
+    seen: list[dict] = []
     watcher = FleetWatcher(seen.append, lambda name, up: None, listen=[endpoint])
-    try:
-        log = tmp_path / "demo.jsonl"
-        done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1", "--fast",
-                               "--record", str(log), "--zenoh", "lab1", "--zenoh-connect", endpoint],
-                              cwd=ROOT, capture_output=True, text=True, timeout=120)
-        assert done.returncode == 0, done.stderr
-        last = max(e["seq"] for e in read_events(str(log)) if e["kind"] != "snapshot")
-        wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what=lambda: "event %d, at %r" % (
-            last, seen[-1]["seq"] if seen else None))
-        assert {e["machine"] for e in seen} == {"lab1:" + MACHINE_NAME}
-    finally:
-        watcher.close()
+    yield endpoint, seen
+    watcher.close()
+
+
+def published(command: list[str], log, endpoint: str) -> int:
+    """Run ``fsmscope COMMAND`` publishing on Zenoh to ``endpoint`` and recording to ``log``; the seq of
+    the last event it recorded."""
+    done = subprocess.run([sys.executable, "-m", "server.cli", *command, "--record", str(log), "--zenoh-connect",
+                           endpoint], cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    return max(e["seq"] for e in read_events(str(log)) if e["kind"] != "snapshot")
+
+
+def test_the_demo_published_with_zenoh_reaches_a_dashboard_to_its_last_event(tmp_path, watching):
+    endpoint, seen = watching
+    last = published(["demo", "--headless", "--episodes", "1", "--fast", "--zenoh", "lab1"], tmp_path / "demo.jsonl",
+                     endpoint)
+    wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the demo's last event")
+    assert {e["machine"] for e in seen} == {"lab1:" + MACHINE_NAME}
 
 
 SCRIPT = """
@@ -83,20 +93,10 @@ sm.execute()
 """
 
 
-def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_path):
-    endpoint = free_endpoint()
-    seen = []
-    watcher = FleetWatcher(seen.append, lambda name, up: None, listen=[endpoint])
-    try:
-        script = tmp_path / "pick.py"
-        script.write_text(SCRIPT)
-        log = tmp_path / "pick.jsonl"
-        done = subprocess.run([sys.executable, "-m", "server.cli", "run", str(script), "--no-serve", "--record",
-                               str(log), "--zenoh", "arm2", "--zenoh-connect", endpoint],
-                              cwd=ROOT, capture_output=True, text=True, timeout=60)
-        assert done.returncode == 0, done.stderr
-        last = max(e["seq"] for e in read_events(str(log)) if e["kind"] != "snapshot")
-        wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
-        assert {e["machine"] for e in seen} == {"arm2:pick"}
-    finally:
-        watcher.close()
+def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_path, watching):
+    endpoint, seen = watching
+    script = tmp_path / "pick.py"
+    script.write_text(SCRIPT)
+    last = published(["run", str(script), "--no-serve", "--zenoh", "arm2"], tmp_path / "pick.jsonl", endpoint)
+    wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
+    assert {e["machine"] for e in seen} == {"arm2:pick"}

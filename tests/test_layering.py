@@ -12,6 +12,8 @@ import ast
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parent.parent
 
 OPTIONAL_FOR_FSM = {"orjson"}
@@ -86,38 +88,21 @@ def test_fsm_imports_only_the_standard_library_and_its_own_lower_layers():
     assert wrong == []
 
 
-def test_sim_never_imports_the_server():
-    wrong = [arrow for path in python_files("sim") for arrow in imports_of(path, "server")]
+# What each package beside fsm must never import: the server composes them, never the reverse.
+NEVER = {"sim": ("server",), "interop": ("server", "sim"), "fleet": ("server", "sim", "interop")}
+
+
+@pytest.mark.parametrize("package", sorted(NEVER))
+def test_a_part_never_imports_the_parts_that_compose_it(package):
+    wrong = [arrow for path in python_files(package) for other in NEVER[package]
+             for arrow in imports_of(path, other)]
     assert wrong == []
 
 
-def test_the_server_imports_sim_only_in_the_composition_root():
+@pytest.mark.parametrize("package", sorted(NEVER))
+def test_the_server_imports_a_part_only_in_the_composition_root(package):
     wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
-             for arrow in imports_of(path, "sim")]
-    assert wrong == []
-
-
-def test_interop_never_imports_the_server_or_the_simulator():
-    wrong = [arrow for path in python_files("interop") for package in ("server", "sim")
              for arrow in imports_of(path, package)]
-    assert wrong == []
-
-
-def test_the_server_imports_interop_only_in_the_composition_root():
-    wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
-             for arrow in imports_of(path, "interop")]
-    assert wrong == []
-
-
-def test_fleet_never_imports_the_server_the_simulator_or_interop():
-    wrong = [arrow for path in python_files("fleet") for package in ("server", "sim", "interop")
-             for arrow in imports_of(path, package)]
-    assert wrong == []
-
-
-def test_the_server_imports_fleet_only_in_the_composition_root():
-    wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
-             for arrow in imports_of(path, "fleet")]
     assert wrong == []
 
 

@@ -32,7 +32,7 @@ demo: install
 test: install
 	$(PY) -m pytest -q
 
-# Every benchmark prints a table (medians) against its target; all of them take ~10 minutes.
+# Every benchmark prints a table (medians) against its target; all of them take ~20 minutes.
 bench: install
 	$(PY) bench/runtime.py
 	$(PY) bench/replay.py
@@ -45,6 +45,8 @@ bench: install
 	$(PY) bench/graph.py
 	$(PY) bench/sim.py
 	$(PY) bench/demo_cpu.py
+	$(PY) bench/bag_import.py
+	$(PY) bench/mcap_export.py
 
 clean:
 	rm -rf $(VENV) *.egg-info .pytest_cache

@@ -47,6 +47,7 @@ bench: install
 	$(PY) bench/demo_cpu.py
 	$(PY) bench/bag_import.py
 	$(PY) bench/mcap_export.py
+	$(PY) bench/fleet_cost.py
 
 clean:
 	rm -rf $(VENV) *.egg-info .pytest_cache

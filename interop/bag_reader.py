@@ -15,6 +15,7 @@ from typing import Iterator
 from rosbags.highlevel import AnyReader
 
 from . import smach_msgs
+from .mcap_header import mcap_header
 from .to_log import ReadError
 
 STRUCTURE_FIELDS = ("path", "children", "internal_outcomes", "outcomes_from", "outcomes_to", "container_outcomes")
@@ -41,17 +42,7 @@ def is_bag(path: str) -> bool:
     p = Path(path)
     if p.is_dir():
         return (p / "metadata.yaml").exists()
-    return p.suffix in (".bag", ".db3") or (p.suffix == ".mcap" and _mcap_profile(p) == "ros2")
-
-
-def _mcap_profile(path: Path) -> str:
-    """The profile an MCAP file's header names ("ros2" for a ROS 2 bag), "" when it has none."""
-    from mcap.reader import make_reader
-    try:
-        with open(path, "rb") as f:
-            return make_reader(f).get_header().profile
-    except Exception:  # not an MCAP at all: the caller says so when it reads it
-        return ""
+    return p.suffix in (".bag", ".db3") or (p.suffix == ".mcap" and getattr(mcap_header(path), "profile", "") == "ros2")
 
 
 def _server(topic: str) -> tuple[str, str] | None:

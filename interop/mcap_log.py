@@ -14,7 +14,7 @@ import struct
 from typing import IO, Callable, Iterable, Iterator
 
 from mcap.exceptions import McapError
-from mcap.reader import NonSeekingReader, make_reader
+from mcap.reader import NonSeekingReader
 from mcap.well_known import MessageEncoding, SchemaEncoding
 from mcap.writer import Writer
 
@@ -22,6 +22,7 @@ from fsm.observation import schema
 from fsm.observation.encoding import dumps, loads
 
 from .channels import Channels, Frame, Message, nanoseconds
+from .mcap_header import mcap_header
 from .to_log import ReadError
 
 LIBRARY = "fsmscope"  # the MCAP header's library: how ``is_fsmscope_mcap`` knows a file as ours
@@ -96,11 +97,7 @@ def write_mcap(events: Iterable[dict], out: str, frames: Callable[[dict], list[F
 
 def is_fsmscope_mcap(path: str) -> bool:
     """Whether ``path`` is an MCAP file fsmscope wrote (its header's library)."""
-    try:
-        with open(path, "rb") as f:
-            return make_reader(f).get_header().library.startswith(LIBRARY)
-    except Exception:  # not an MCAP, unreadable: not ours
-        return False
+    return getattr(mcap_header(path), "library", "").startswith(LIBRARY)
 
 
 def read_mcap(path: str, on_problem: Callable[[str], None] | None = None) -> Iterator[dict]:

@@ -65,7 +65,8 @@ def read_bag(path: str) -> Iterator[Message]:
         raise BagError("%s: cannot read this bag (%s: %s)" % (path, type(exc).__name__, exc)) from None
     try:
         found = {c.id: _server(c.topic) for c in reader.connections}
-        wanted = [c for c in reader.connections if found[c.id] and c.msgtype in (smach_msgs.STRUCTURE, smach_msgs.STATUS)]
+        wanted = [c for c in reader.connections
+                  if found[c.id] and c.msgtype in (smach_msgs.STRUCTURE, smach_msgs.STATUS)]
         if not wanted:
             topics = sorted({c.topic for c in reader.connections})
             raise BagError("%s: no SMACH introspection topics (…%s, …%s) among its %d topics%s" % (

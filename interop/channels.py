@@ -42,7 +42,8 @@ def _event_schema() -> dict:
             "properties": {"v": {"type": "integer"}, "seq": {"type": "integer"}, "t": {"type": "number"},
                            "run": {"type": ["string", "null"]}, "machine": {"type": "string"},
                            "kind": {"enum": sorted(k for k in schema.KINDS if k != "snapshot"),
-                                    "description": "; ".join("%s: %s" % (k.name, k.doc) for k in schema.KINDS.values())},
+                                    "description": "; ".join("%s: %s" % (k.name, k.doc)
+                                                             for k in schema.KINDS.values())},
                            "path": {"type": "string"}},
             "required": ["v", "seq", "t", "run", "machine", "kind", "path"]}
 

@@ -64,7 +64,8 @@ class _Out:
                 known = type(m.data).get_schema()
                 encoding, sid = known.encoding, self.schema(known.name, known.encoding, bytes(known.data))
             channel = self.channel(m.topic, encoding, sid)
-        self.writer.add_message(channel_id=channel, log_time=nanoseconds(m.t), publish_time=nanoseconds(m.t), sequence=self.count,
+        self.writer.add_message(channel_id=channel, log_time=nanoseconds(m.t), publish_time=nanoseconds(m.t),
+                                sequence=self.count,
                                 data=dumps(m.data) if m.schema is not None else m.data.encode())
         self.count += 1
 

@@ -193,7 +193,8 @@ class _Machine:
             self.left[path] = [source]
         self.active[path] = list(now)
         if source is not None:
-            yield self._event("transition", path, {"from": source, "outcome": outcome, "to": target, "active": list(now)})
+            yield self._event("transition", path, {"from": source, "outcome": outcome, "to": target,
+                                                   "active": list(now)})
 
     def _leave(self, path: str, state: str, outcome: str | None) -> Iterator[dict]:
         """A state its container left: when it is a running container, it terminated (with ``outcome``,

@@ -58,9 +58,10 @@ class FleetWatcher:
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
         # process from ending); the events' channel drops the oldest when full (the gap is filled after).
         self._events = self.session.declare_subscriber(keys.ALL_EVENTS, zenoh.handlers.RingChannel(QUEUE))
-        self._tokens = self.session.liveliness().declare_subscriber(keys.ALL_MACHINES, zenoh.handlers.FifoChannel(QUEUE),
-                                                                   history=True)
-        for name, subscriber, read in (("events", self._events, self._on_events), ("tokens", self._tokens, self._on_token)):
+        self._tokens = self.session.liveliness().declare_subscriber(
+            keys.ALL_MACHINES, zenoh.handlers.FifoChannel(QUEUE), history=True)
+        for name, subscriber, read in (("events", self._events, self._on_events),
+                                       ("tokens", self._tokens, self._on_token)):
             threading.Thread(target=self._read, args=(subscriber, read), name="fsmscope-fleet-" + name,
                              daemon=True).start()
         closing.close_at_exit(self)

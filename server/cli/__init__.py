@@ -2,7 +2,8 @@
 
 Each subcommand is a module of this package that composes the components for one use: the
 runtime (``fsm``), the recorder, the script runner (``server.runner``), the dashboard's server
-(``server.http_server.ServerThread`` and its hub), the simulator (``sim``) and the bag reader (``interop``). Nothing else in
+(``server.http_server.ServerThread`` and its hub), the simulator (``sim``), the robotics world's files
+(``interop``) and the fleet (``fleet``). Nothing else in
 ``server`` imports ``sim``, and ``sim`` never imports ``server``.
 
 A subcommand module has::
@@ -34,8 +35,8 @@ class Subcommand(Protocol):
     def main(self, args: argparse.Namespace) -> int: ...
 
 
-SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "export": export, "import": bag_import,
-                                      "demo": demo}
+SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "export": export,
+                                      "import": bag_import, "demo": demo}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -7,6 +7,7 @@ worker thread, never on the event loop.
 from __future__ import annotations
 
 import threading
+import time
 from typing import TYPE_CHECKING, Any, Callable
 
 from fsm.observation import introspection
@@ -16,7 +17,7 @@ if TYPE_CHECKING:
     from .debug_control import DebugControl
 
 
-LAST_RUN_GRACE = 1.0  # seconds a start waits for this handle's previous run to return
+LAST_RUN_GRACE = 1.0  # seconds a start waits for the previous run's execute() to return
 
 
 class ControlError(Exception):
@@ -171,10 +172,9 @@ class MachineHandle:
             if not self.can_start:
                 self.emit_control("start", client, "this process cannot re-run the machine")
                 raise ControlError(409, "this process cannot re-run the machine (can_start is false)")
-            if self.is_running():
-                # The last run's outcome is out (a page can ask for the next run at once) a moment
-                # before its execute() has returned: give a run of ours that long to wind down.
-                self.join(LAST_RUN_GRACE)
+            # The last run's outcome is out (a page can ask for the next run at once) a moment before
+            # its execute() has returned, in our thread or the process's own: give it that long.
+            self._wait_until_stopped(LAST_RUN_GRACE)
             if self.is_running():
                 self.emit_control("start", client, "already running")
                 raise ControlError(409, "machine is running")
@@ -195,6 +195,12 @@ class MachineHandle:
             self._thread = thread
             thread.start()
         return seq
+
+    def _wait_until_stopped(self, timeout: float) -> None:
+        deadline = time.monotonic() + timeout
+        self.join(timeout)
+        while self.is_running() and time.monotonic() < deadline:
+            time.sleep(0.01)
 
     def _run(self) -> None:
         try:

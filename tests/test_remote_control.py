@@ -9,6 +9,7 @@ import os
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 
 import fsm
@@ -243,3 +244,26 @@ def test_a_publishing_script_needs_no_web_framework():
     loaded = subprocess.run([sys.executable, "-c", "import sys, server.publisher; print(' '.join(sys.modules))"],
                             cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
     assert [m for m in loaded if m.split(".")[0] in ("fastapi", "starlette", "pydantic", "uvicorn")] == []
+
+
+def test_a_start_waits_for_a_run_of_another_thread_to_return():
+    """The page may ask for the next run as soon as the outcome is out, while the thread that ran
+    the machine (the process's own, not the handle's) is still returning from execute()."""
+    runs = []
+
+    def slow(ud):
+        runs.append(time.monotonic())
+        time.sleep(0.3)
+        return "done"
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(slow, outcomes=["done"]), {"done": "done"})
+    handle = MachineHandle(sm, fsm.attach(sm, name="m"), can_start=True)
+    own = threading.Thread(target=sm.execute)
+    own.start()
+    wait_for(lambda: runs, 5)
+    handle.start("me")  # raised ControlError(409, "machine is running") before it waited
+    own.join(5)
+    handle.join(5)
+    assert len(runs) == 2

@@ -18,7 +18,8 @@ from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from swagger_ui_bundle import swagger_ui_path
 
-from .local_control import ControlError
+from fsm.control.handle import ControlError
+
 from .hub import Hub
 from .lease import Deadman, Leases
 from .lease_control import LeaseControl

@@ -14,12 +14,12 @@ import threading
 import time
 from typing import TYPE_CHECKING, Any, Callable
 
+from fsm.control.handle import MachineHandle
 from fsm.observation import introspection, schema
 from fsm.observation import structure
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 
-from .local_control import MachineHandle
 from .fanout import Fanout, Feed, Observer
 from .history import History, LogHistory
 from .state_stats import StateStats

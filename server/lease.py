@@ -24,7 +24,8 @@ import time
 from dataclasses import dataclass
 from typing import Callable
 
-DEADMAN_ACTIONS = ("pause", "preempt", "none")
+from fsm.control.frames import DEADMAN_ACTIONS
+
 BEAT_EVERY = 1.0  # seconds between a holder page's heartbeats (static/lease.js reads it from GET .../lease)
 
 

@@ -14,8 +14,8 @@ from typing import Any
 
 from .hub import Hub, MachineEntry
 from .lease import Lease, Leases, short
-from .local_control import MachineHandle
-from .publisher_control import apply_deadman
+from fsm.control.frames import apply_deadman
+from fsm.control.handle import MachineHandle
 from .remote_control import RemoteHandle
 
 DEADMAN = "deadman"  # the client of what the deadman does

@@ -18,7 +18,7 @@ script that ends right after its machine does not leave the dashboard showing it
 
 Every machine attached to it takes the dashboard's controls (docs/debugging.md, "Remote machines"):
 the server sends ``control`` frames over the same connection, a worker thread applies them
-(server/publisher_control.py) and the sender answers each after the events it caused. While an
+(fsm/control/frames.py) and the sender answers each after the events it caused. While an
 operator holds a machine's lease, a connection lost for longer than the lease's ``after`` makes
 the publisher apply the deadman itself.
 
@@ -35,13 +35,13 @@ import time
 import urllib.parse
 from typing import Any
 
+from fsm.control.frames import answer, apply_deadman, lease_of
+from fsm.control.handle import MachineHandle
 from fsm.observation import closing, introspection, schema
 from fsm.observation.encoding import dumps, loads
 from fsm.observation.handoff import Handoff
 from fsm.observation.status import Status
 
-from .local_control import MachineHandle
-from .publisher_control import answer, apply_deadman, lease_of
 
 BUFFER = 100_000      # events held for the sender before the oldest are dropped
 MAX_BATCH = 2000      # events per frame

@@ -17,9 +17,9 @@ from typing import TYPE_CHECKING, Any, Awaitable, Callable
 
 from pydantic import ValidationError
 
+from fsm.control.handle import ControlError
 from fsm.observation.encoding import dumps
 
-from .local_control import ControlError
 from .models import BreakpointSpec
 
 if TYPE_CHECKING:

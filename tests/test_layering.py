@@ -1,7 +1,7 @@
 """The layering, kept by reading every import (ast), including those inside functions.
 
 fsm is the runtime: the standard library only (orjson when installed) and nothing of the web or
-the simulator. Inside fsm the core never imports its extensions (ros, logfiles, debugging). sim never imports
+the simulator. Inside fsm the core never imports its extensions (ros, logfiles, debugging, control). sim never imports
 server; interop (bags, MCAP, Foxglove) and fleet (Zenoh) import neither; server imports sim, interop
 and fleet only in its composition root, the CLI (server/cli/).
 """
@@ -26,6 +26,7 @@ FSM_ARROWS = {
     "ros": {"ros", "core", "observation"},
     "logfiles": {"logfiles", "observation", "core"},
     "debugging": {"debugging", "observation", "core"},
+    "control": {"control", "debugging", "observation", "core"},
 }
 
 COMPOSITION_ROOT = ROOT / "server" / "cli"

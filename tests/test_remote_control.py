@@ -14,13 +14,13 @@ import time
 
 import fsm
 import pytest
+from fsm.control.frames import answer
+from fsm.control.handle import MachineHandle
 from websockets.sync.client import connect
 
 from browser_support import ROOT
 from event_support import flat_root, run_of
 from server import remote_control
-from server.local_control import MachineHandle
-from server.publisher_control import answer
 from server.testing.polling import wait_for
 from server_support import client, sleeper
 

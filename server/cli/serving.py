@@ -9,7 +9,9 @@ import sys
 import threading
 from typing import TYPE_CHECKING, Any
 
-from ..lease import DEADMAN_ACTIONS, Deadman
+from fsm.control.frames import DEADMAN_ACTIONS
+
+from ..lease import Deadman
 
 if TYPE_CHECKING:
     from ..http_server import ServerThread

@@ -1,5 +1,5 @@
 """What a page can do to a machine of this process: preempt, hold, set its initial state, start it,
-and publish on the in-process bus. The machine's side is server/local_control.py; its calls may block
+and publish on the in-process bus. The machine's side is fsm/control/handle.py; its calls may block
 briefly on the machine's locks, so they run in a worker thread, never on the event loop."""
 
 from __future__ import annotations
@@ -9,8 +9,9 @@ from typing import Annotated, Any
 from fastapi import APIRouter, Body, Path
 from fastapi.concurrency import run_in_threadpool
 
+from fsm.ros.bus import default_bus
+
 from .. import models
-from ..local_control import publish
 from .deps import ERRORS, LEASED, OPERATOR, ClientAddress, Handle, HubDep
 
 router = APIRouter(dependencies=OPERATOR, responses=ERRORS, tags=["control"])
@@ -52,7 +53,7 @@ async def publish_topic(topic: Annotated[str, TOPIC], hub: HubDep, client: Clien
                         message: Annotated[Any, Body(description="any JSON value: the message")] = None
                         ) -> models.Delivered:
     def do() -> int:
-        delivered = publish(topic, message)
+        delivered = default_bus.publish(topic, message)
         for entry in hub.machines():
             if entry.handle is not None and entry.handle.is_running():
                 entry.handle.emit_control("publish", client, "accepted",

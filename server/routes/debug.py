@@ -1,5 +1,5 @@
 """The debugger's controls (docs/debugging.md): pause, resume, step, force an outcome, and the
-breakpoints as a set to read and replace. The machine's side is server/debug_control.py; its
+breakpoints as a set to read and replace. The machine's side is fsm/control/debug.py; its
 calls may block briefly on the debugger's lock, so they run in a worker thread."""
 
 from __future__ import annotations
@@ -9,8 +9,9 @@ from typing import Annotated
 from fastapi import APIRouter, Body, Depends
 from fastapi.concurrency import run_in_threadpool
 
+from fsm.control.debug import DebugControl
+
 from .. import models
-from ..debug_control import DebugControl
 from ..remote_control import RemoteHandle
 from .deps import AUTH, ERRORS, LEASED, OPERATOR, ClientAddress, Handle
 

@@ -8,9 +8,10 @@ from typing import Annotated
 from fastapi import Depends, HTTPException, Path, Request, WebSocket
 from starlette.requests import HTTPConnection
 
+from fsm.control.handle import MachineHandle
+
 from .. import models
 from ..auth import require_operator, require_token, websocket_refusal
-from ..local_control import MachineHandle
 from ..hub import Hub, MachineEntry
 from ..lease import LeaseHeld
 from ..lease_control import LeaseControl

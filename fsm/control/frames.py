@@ -1,19 +1,17 @@
 """The publishing process's side of remote control (server/remote_control.py is the server's): a
 control frame applied to a machine of this process through the same ``MachineHandle`` and
 ``DebugControl`` a local machine's requests go through, and the deadman a publisher applies itself
-when its connection to the dashboard is gone while an operator holds the machine's lease.
-
-Imports only the standard library and ``fsm`` (through local_control and debug_control): a
-publishing script does not need FastAPI.
+when its connection to the dashboard is gone while an operator holds the machine's lease. The
+websocket publisher (server/publisher.py) and the Zenoh robot (fleet/robot.py) both apply frames here.
 """
 
 from __future__ import annotations
 
 from typing import Any, Callable
 
-from .lease import DEADMAN_ACTIONS
-from .local_control import ControlError, MachineHandle
+from .handle import ControlError, MachineHandle
 
+DEADMAN_ACTIONS = ("pause", "preempt", "none")  # what a deadman does when its lease lapses
 MAX_AFTER = 86400.0  # a deadman's delay longer than a day is not one (and would overflow a timer's wait)
 
 

@@ -14,7 +14,7 @@ from fsm.observation import introspection
 from fsm.observation import structure
 
 if TYPE_CHECKING:
-    from .debug_control import DebugControl
+    from .debug import DebugControl
 
 
 LAST_RUN_GRACE = 1.0  # seconds a start waits for the previous run's execute() to return
@@ -75,7 +75,7 @@ class MachineHandle:
 
     def debug_control(self) -> DebugControl:
         """Its debugger's controls: what the debug routes call on every kind of handle."""
-        from .debug_control import DebugControl  # that module builds on this one
+        from .debug import DebugControl  # that module builds on this one
 
         return DebugControl(self)
 
@@ -213,9 +213,3 @@ class MachineHandle:
         if thread is not None:
             thread.join(timeout)
 
-
-def publish(topic: str, message: Any) -> int:
-    """Publish on the in-process bus; returns how many subscribers it reached."""
-    from fsm.ros.bus import default_bus
-
-    return default_bus.publish(topic, message)

@@ -12,7 +12,7 @@ from typing import Any, Callable
 
 from fsm.debugging import DebugError, debugger_of
 
-from .local_control import ControlError, MachineHandle
+from .handle import ControlError, MachineHandle
 
 # The HTTP status of each kind of refusal: the request's content is wrong (422), or the machine
 # is not in a state to take it (409).

@@ -35,6 +35,11 @@ def history_key(robot: str, machine: str) -> str:
     return machine_key(robot, machine) + "/history"
 
 
+def control_key(robot: str, machine: str) -> str:
+    """The queryable that applies a control to the machine (fleet/control.py) and answers its result."""
+    return machine_key(robot, machine) + "/control"
+
+
 ALL_MACHINES = PREFIX + "/*/*"
 ALL_EVENTS = PREFIX + "/*/*/events"
 

@@ -11,9 +11,11 @@ it also declares, on the machine's first event:
 - a liveliness token on ``fsmscope/<robot>/<machine>``: dashboards see the machine appear, and
   see it gone within Zenoh's lease when the process dies or drops off the network;
 - a queryable ``.../state``: the machine's snapshot event (its whole state now), for a dashboard
-  that joins late;
+  that joins late, and what controls it takes;
 - a queryable ``.../history?since=SEQ``: the events from SEQ on that the ring still holds (a
-  dashboard whose connection dropped fills its gap; older than the ring: it takes the snapshot).
+  dashboard whose connection dropped fills its gap; older than the ring: it takes the snapshot);
+- a queryable ``.../control``: a dashboard's control, carrying the robot's token, applied to the
+  machine and answered (fleet/control.py).
 
 When nobody listens or the network is gone, puts go nowhere and the machine runs on; memory stays
 bounded by the buffer and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
@@ -28,30 +30,36 @@ from typing import Any, Sequence
 
 import zenoh
 
-from fsm.observation import closing, schema
+from fsm.control.handle import MachineHandle
+from fsm.observation import closing, introspection, schema
 from fsm.observation.encoding import dumps
 from fsm.observation.handoff import Handoff
 from fsm.observation.status import Status
 
 from . import keys
 from .config import session_config
+from .control import RobotControls
 
 BUFFER = 100_000  # events waiting for the sender before the oldest are dropped
 RING = 10_000  # events of each machine kept for history queries
 MAX_BATCH = 2000  # events per put
+CONTROL_SETTLE = 1.0  # seconds a control's answer waits for the events it caused to be put
 
 
 class _Machine:
     """What the robot keeps of one machine, and its Zenoh entities."""
 
-    def __init__(self, session: zenoh.Session, robot: str, name: str) -> None:
+    def __init__(self, session: zenoh.Session, robot: str, name: str, controls: RobotControls) -> None:
         self.status = Status(name)
         self.ring: collections.deque[dict] = collections.deque(maxlen=RING)
         self.lock = threading.Lock()  # queries come from Zenoh's threads
+        self.controls = controls
+        self.origin = str(session.zid())  # a new process is a new session: its seqs start again
         self.publisher = session.declare_publisher(keys.events_key(robot, name),
                                                    congestion_control=zenoh.CongestionControl.DROP)
         self.state = session.declare_queryable(keys.state_key(robot, name), self._state)
         self.history = session.declare_queryable(keys.history_key(robot, name), self._history)
+        self.control = controls.declare(session, keys.control_key(robot, name), name)
         self.token = session.liveliness().declare_token(keys.machine_key(robot, name))  # last: all is there
 
     def _state(self, query: zenoh.Query) -> None:
@@ -59,7 +67,8 @@ class _Machine:
             status = self.status
             snapshot = schema.event(status.last_seq, time.time(), status.run, status.machine, "snapshot",
                                     status.root_path or "/SM_ROOT", {"status": status.to_dict()})
-        query.reply(query.key_expr, dumps(snapshot))
+        query.reply(query.key_expr, dumps({"snapshot": snapshot, "controls": self.controls.offer(status.machine),
+                                           "origin": self.origin}))
 
     def _history(self, query: zenoh.Query) -> None:
         try:
@@ -74,21 +83,26 @@ class _Machine:
         query.reply(query.key_expr, dumps({"complete": first is not None and first <= since, "events": events}))
 
     def close(self) -> None:
-        for entity in (self.token, self.history, self.state, self.publisher):
+        for entity in (self.token, self.control, self.history, self.state, self.publisher):
             entity.undeclare()
 
 
 class ZenohRobot:
     """An observer (``fsm.attach(sm, ZenohRobot("r1", ...))``) that puts a robot's machines on Zenoh.
     ``connect`` / ``listen``: Zenoh endpoints (``tcp/HOST:PORT``); ``mode``: "peer" or "client";
-    ``scouting``: multicast discovery on the LAN (off unless asked)."""
+    ``scouting``: multicast discovery on the LAN (off unless asked). ``token``: what a dashboard's
+    control must carry (none: the robot takes no control); ``can_start``: whether a start may run a
+    machine again (in a new thread)."""
 
     def __init__(self, robot: str, connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
-                 scouting: bool = False, buffer: int = BUFFER) -> None:
+                 scouting: bool = False, buffer: int = BUFFER, token: str | None = None,
+                 can_start: bool = False) -> None:
         self.robot = keys.chunk(robot, "robot")
+        self.can_start = can_start
         self.session = zenoh.open(session_config(connect, listen, mode, scouting))
         self._handoff = Handoff(buffer)
         self._buf = self._handoff.events
+        self.controls = RobotControls(token, lambda: self._handoff.drained(CONTROL_SETTLE))
         self._stop = threading.Event()
         self._machines: dict[str, _Machine] = {}
         self.sent = 0
@@ -99,6 +113,15 @@ class ZenohRobot:
     # The observer: runs in the machine's thread.
     def __call__(self, event: dict) -> None:
         self._handoff(event)
+
+    def attached(self, reporter: introspection.Reporter) -> None:
+        """``fsm.attach`` gave this robot a machine: it takes the dashboards' controls from now on."""
+        self.controls.handles.setdefault(reporter.machine, MachineHandle(reporter.root, reporter, self.can_start))
+
+    def take_controls(self, handle: MachineHandle) -> None:
+        """Apply the controls of ``handle``'s machine through ``handle``: a host's own (one that runs the
+        machine in its own loop, as the demo does) rather than one of the robot's."""
+        self.controls.handles[handle.reporter.machine] = handle
 
     @property
     def dropped(self) -> int:
@@ -121,6 +144,7 @@ class ZenohRobot:
             self._thread.join(timeout)
         for machine in self._machines.values():
             machine.close()
+        self.controls.close()
         self.session.close()
         closing.closed(self)
 
@@ -153,7 +177,8 @@ class ZenohRobot:
         for name, events in batches.items():
             machine = self._machines.get(name)
             if machine is None:
-                machine = self._machines[name] = _Machine(self.session, self.robot, keys.chunk(name, "machine"))
+                machine = self._machines[name] = _Machine(self.session, self.robot, keys.chunk(name, "machine"),
+                                                          self.controls)
             with machine.lock:
                 for event in events:
                     machine.status.apply(event)

@@ -7,12 +7,17 @@ those alive before the dashboard came too). On finding one the watcher asks its 
 seq order. An event beyond the next one expected (batches were lost while the network was down)
 makes it ask ``.../history?since=`` for the missing ones first; when the robot no longer keeps
 them, it takes a new snapshot instead. A token withdrawn (the robot's process ended, or dropped off
-the network past Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine.
+the network past Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine:
+with the events it missed when its process is the same (its session's id, which the state answer
+carries), with a new snapshot when the process is a new one (its seqs start again).
 
 Each delivered event carries the dashboard's name of the machine, ``<robot>:<machine>``: machines
 of different robots may share a name. Two threads read Zenoh's channels and queue what arrived (a
 bounded queue: a batch that finds it full is dropped, and filled from history after); one thread of
 the watcher's handles the queue in order, asks the queries and delivers.
+
+What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
+sends a control to the machine's robot (fleet/control.py).
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ import zenoh
 from fsm.observation import closing
 from fsm.observation.encoding import loads
 
-from . import keys
+from . import control, keys
 from .config import session_config
 
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
@@ -49,6 +54,8 @@ class FleetWatcher:
         self.alive = alive
         self.session = zenoh.open(session_config(connect, listen, mode, scouting))
         self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
+        self.controls: dict[str, dict | None] = {}  # machine -> what its robot said of its controls
+        self._origins: dict[str, str] = {}  # machine -> the session id of the robot's process
         self._queue: queue.Queue[tuple[str, str, bytes | bool] | None] = queue.Queue(QUEUE)
         self.gaps_filled = 0
         self.snapshots = 0
@@ -78,6 +85,12 @@ class FleetWatcher:
         closing.closed(self)
 
     _closed = False
+
+    def __enter__(self) -> FleetWatcher:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
 
     @staticmethod
     def _read(subscriber: zenoh.Subscriber, handle: Callable[[zenoh.Sample], None]) -> None:
@@ -112,10 +125,7 @@ class FleetWatcher:
             name = fleet_name(robot, machine)
             if what is True:
                 self.alive(name, True)
-                if name not in self._last:
-                    self._snapshot(robot, machine)
-                else:
-                    self._fill(robot, machine, self._last[name] + 1)  # back after a drop: what it missed
+                self._join(robot, machine)
             elif what is False:
                 self.alive(name, False)
             elif name not in self._last:  # not joined: its state did not answer yet (Zenoh had not told it)
@@ -136,18 +146,39 @@ class FleetWatcher:
             last = event["seq"]
         self._last[name] = last
 
-    def _snapshot(self, robot: str, machine: str) -> None:
+    def _state(self, robot: str, machine: str) -> dict | None:
+        """The machine's state answer (its snapshot, controls and origin); None when none came."""
         for reply in self.session.get(keys.state_key(robot, machine), timeout=QUERY_TIMEOUT):
-            if reply.ok is None:
-                continue
-            snapshot = loads(reply.ok.payload.to_bytes())
-            name = fleet_name(robot, machine)
-            snapshot["machine"] = name
-            snapshot["status"]["machine"] = name
-            self.deliver(snapshot)
-            self._last[name] = snapshot["seq"]
-            self.snapshots += 1
+            if reply.ok is not None:
+                return loads(reply.ok.payload.to_bytes())
+        return None
+
+    def _join(self, robot: str, machine: str) -> None:
+        """A machine seen alive: new, or back after a drop (what it missed), or from a new process."""
+        name = fleet_name(robot, machine)
+        answer = self._state(robot, machine)
+        if answer is None:
             return
+        if name in self._last and answer["origin"] == self._origins.get(name):
+            self._fill(robot, machine, self._last[name] + 1)
+        else:
+            self._take(name, answer)
+
+    def _snapshot(self, robot: str, machine: str) -> None:
+        answer = self._state(robot, machine)
+        if answer is not None:
+            self._take(fleet_name(robot, machine), answer)
+
+    def _take(self, name: str, answer: dict) -> None:
+        """Deliver a state answer's snapshot: the machine's whole state, from which its events go on."""
+        snapshot = answer["snapshot"]
+        self.controls[name] = answer.get("controls")
+        self._origins[name] = answer["origin"]
+        snapshot["machine"] = name
+        snapshot["status"]["machine"] = name
+        self.deliver(snapshot)
+        self._last[name] = snapshot["seq"]
+        self.snapshots += 1
 
     def _fill(self, robot: str, machine: str, since: int) -> None:
         """The events from ``since`` on, from the robot's history; a snapshot when it no longer has them."""
@@ -162,3 +193,8 @@ class FleetWatcher:
             self._deliver(name, answer["events"])
             self.gaps_filled += 1
             return
+
+    def ask(self, robot: str, machine: str, token: str, action: str, params: dict, client: str) -> dict | None:
+        """A control for ``robot``'s ``machine``: its robot's answer, None when none came in time."""
+        return control.ask(self.session, keys.control_key(robot, machine), token, action, params, client,
+                           QUERY_TIMEOUT)

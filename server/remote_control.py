@@ -139,17 +139,23 @@ class IngestLink:
                 raise self._late(machine) from None
         finally:
             self._pending.pop(answer_id, None)
-        status = answer.get("status")
-        if type(status) is int and 400 <= status < 500:
-            detail = answer.get("detail")
-            raise ControlError(status, detail if type(detail) is str else "refused by the publishing process")
-        if status not in (200, 202):
-            raise malformed(machine, "status %r" % (status,))
-        return answer
+        return taken(machine, answer)
 
     @staticmethod
     def _late(machine: str) -> ControlError:
         return ControlError(504, "the publishing process of %r did not answer within %g s" % (machine, ANSWER_TIMEOUT))
+
+
+def taken(machine: str, answer: dict) -> dict:
+    """``answer`` when it says the control was taken (2xx); else ControlError with the machine's status
+    and message for a refusal (4xx), or 502 for an answer that says neither."""
+    status = answer.get("status")
+    if type(status) is int and 400 <= status < 500:
+        detail = answer.get("detail")
+        raise ControlError(status, detail if type(detail) is str else "refused by the publishing process")
+    if status not in (200, 202):
+        raise malformed(machine, "status %r" % (status,))
+    return answer
 
 
 def malformed(machine: str, what: str) -> ControlError:

@@ -18,21 +18,25 @@ def free_endpoint() -> str:
 
 
 class Tick(fsm.State):
-    """Waits ``pause`` seconds, then goes on, until the loop has ticked ``steps`` times."""
+    """Waits ``pause`` seconds, then goes on, until the loop has ticked ``steps`` times or is preempted."""
 
     def __init__(self, count: list[int], steps: int, pause: float) -> None:
-        fsm.State.__init__(self, ["go", "stop"])
+        fsm.State.__init__(self, ["go", "stop"], output_keys=["ticks"])
         self.count, self.steps, self.pause = count, steps, pause
 
     def execute(self, ud):
         time.sleep(self.pause)
         self.count[0] += 1
         ud.ticks = self.count[0]
+        if self.preempt_requested():
+            self.service_preempt()
+            return "stop"
         return "stop" if self.count[0] >= self.steps else "go"
 
 
 def slow_loop(steps: int, pause: float = 0.01) -> fsm.StateMachine:
-    """A -> B -> A ... ``steps`` ticks of ``pause`` seconds, then done; its userdata counts the ticks."""
+    """A -> B -> A ... ``steps`` ticks of ``pause`` seconds (or until preempted), then done; its userdata
+    counts the ticks."""
     count = [0]
     sm = fsm.StateMachine(["done"])
     sm.userdata.ticks = 0

@@ -9,6 +9,7 @@ import re
 import signal
 import subprocess
 import sys
+import threading
 
 import fsm
 import httpx
@@ -24,35 +25,102 @@ from server.testing.polling import wait_for
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
-def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leaves():
-    fsm.set_loggers(*(lambda msg: None,) * 4)
-    endpoint = free_endpoint()
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
-                             "--zenoh-listen", endpoint], cwd=ROOT, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True)
-    try:
-        for line in proc.stderr:
+class Dashboard:
+    """``fsmscope serve --zenoh`` in a real process, listening on a Zenoh endpoint of its own."""
+
+    def __init__(self, *options: str) -> None:
+        self.endpoint = free_endpoint()
+        self.proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
+                                      "--zenoh-listen", self.endpoint, *options], cwd=ROOT, stderr=subprocess.PIPE,
+                                     text=True, start_new_session=True)
+        for line in self.proc.stderr:
             found = re.search(r"serving the dashboard at (http://\S+)", line)
             if found:
                 break
-        url = found.group(1)
-        base, token = url.split("/?token=")
-        machines = lambda: {m["name"]: m for m in httpx.get(base + "/api/machines", params={"token": token}).json()}
-        robot = ZenohRobot("r1", connect=[endpoint])
-        own = []
-        sm = slow_loop(40)
-        fsm.attach(sm, robot, name="loop")
-        fsm.attach(sm, own.append)
-        sm.execute()
-        robot.flush()
-        wait_for(lambda: machines().get("r1:loop", {}).get("last_seq") == own[-1]["seq"], 15,
-                 what=lambda: "r1:loop at seq %d: %r" % (own[-1]["seq"], machines()))
-        assert machines()["r1:loop"]["connected"] is True
-        robot.close()
-        wait_for(lambda: machines()["r1:loop"]["connected"] is False, 15, what="r1:loop shown gone")
+        self.base, self.token = found.group(1).split("/?token=")
+
+    def machines(self) -> dict[str, dict]:
+        return {m["name"]: m for m in httpx.get(self.base + "/api/machines", params={"token": self.token}).json()}
+
+    def post(self, path: str, body: dict) -> httpx.Response:
+        return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
+
+    def stop(self) -> None:
+        os.killpg(self.proc.pid, signal.SIGINT)
+        self.proc.wait(20)
+
+
+@pytest.fixture
+def dashboard_with():
+    """A dashboard started with these options; stopped after the test."""
+    started: list[Dashboard] = []
+
+    def start(*options: str) -> Dashboard:
+        started.append(Dashboard(*options))
+        return started[-1]
+
+    yield start
+    for dash in started:
+        dash.stop()
+
+
+def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leaves(dashboard_with):
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    dash = dashboard_with()
+    robot = ZenohRobot("r1", connect=[dash.endpoint])
+    own = []
+    sm = slow_loop(40)
+    fsm.attach(sm, robot, name="loop")
+    fsm.attach(sm, own.append)
+    sm.execute()
+    robot.flush()
+    wait_for(lambda: dash.machines().get("r1:loop", {}).get("last_seq") == own[-1]["seq"], 15,
+             what=lambda: "r1:loop at seq %d: %r" % (own[-1]["seq"], dash.machines()))
+    assert dash.machines()["r1:loop"]["connected"] is True
+    robot.close()
+    wait_for(lambda: dash.machines()["r1:loop"]["connected"] is False, 15, what="r1:loop shown gone")
+
+
+def running_robot(endpoint: str, token: str):
+    """Robot r1 with token ``token``, its machine "loop" running until preempted: (robot, its events, thread)."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    robot = ZenohRobot("r1", connect=[endpoint], token=token)
+    own: list[dict] = []
+    sm = slow_loop(100_000, 0.02)
+    fsm.attach(sm, robot, name="loop")
+    fsm.attach(sm, own.append)
+    runner = threading.Thread(target=sm.execute, daemon=True)
+    runner.start()
+    return robot, own, runner
+
+
+def test_a_preempt_asked_of_the_dashboard_ends_the_run_on_the_robot(dashboard_with):
+    dash = dashboard_with("--zenoh-token", "r1=secret")
+    robot, own, runner = running_robot(dash.endpoint, "secret")
+    try:
+        wait_for(lambda: dash.machines().get("r1:loop", {}).get("controllable"), 15, what="r1:loop controllable")
+        answer = dash.post("/api/machines/r1:loop/preempt", {"reason": "from the dashboard"})
+        assert answer.status_code == 202, answer.text
+        runner.join(10)
+        assert [(e["action"], e["result"], e["seq"]) for e in own if e["kind"] == "control"] == [
+            ("preempt", "accepted", answer.json()["seq"])]
+        wait_for(lambda: not dash.machines()["r1:loop"]["running"], 15, what="the run shown ended")
     finally:
-        os.killpg(proc.pid, signal.SIGINT)
-        proc.wait(20)
+        robot.close()
+
+
+def test_a_dashboard_with_the_wrong_token_is_refused_by_the_robot(dashboard_with):
+    dash = dashboard_with("--zenoh-token", "r1=guess")
+    robot, own, runner = running_robot(dash.endpoint, "secret")
+    try:
+        wait_for(lambda: dash.machines().get("r1:loop", {}).get("controllable"), 15, what="r1:loop controllable")
+        answer = dash.post("/api/machines/r1:loop/preempt", {})
+        assert (answer.status_code, answer.json()["detail"]) == (403, "wrong token for this robot's controls")
+        assert robot.controls.refused == 1 and runner.is_alive()
+    finally:
+        robot.controls.handles["loop"].preempt(None, "test")
+        runner.join(10)
+        robot.close()
 
 
 @pytest.fixture

@@ -27,11 +27,12 @@ class Dashboard:
         self.watcher = FleetWatcher(self.events.append, lambda name, up: self.alive.append((name, up)), **session)
 
     def status(self, name: str) -> Status:
-        """The machine's state rebuilt from what was delivered (a snapshot, then events)."""
+        """The machine's state rebuilt from what was delivered: its last snapshot, then events."""
+        events = [event for event in self.events if event["machine"] == name]
+        start = max(i for i, event in enumerate(events) if event["kind"] == "snapshot")
         status = Status(name)
-        for event in self.events:
-            if event["machine"] == name:
-                status.apply(event)
+        for event in events[start:]:
+            status.apply(event)
         return status
 
 
@@ -106,6 +107,24 @@ def test_a_robot_that_leaves_is_seen_gone_and_seen_back(quiet):
             wait_for(lambda: dash.alive[-1] == ("r1:loop", True), 10, what="the machine seen back")
         finally:
             again.close()
+    finally:
+        dash.watcher.close()
+
+
+def test_a_robot_back_as_a_new_process_is_shown_from_a_new_snapshot(quiet):
+    """Its seqs start again: what the dashboard shows is the new process's run, not the old one's."""
+    endpoint = free_endpoint()
+    dash = Dashboard(listen=[endpoint])
+    try:
+        with ZenohRobot("r1", connect=[endpoint]) as robot:
+            run_on(robot, slow_loop(40, 0.0))
+            wait_for(lambda: dash.events and dash.events[-1]["seq"] > 40, 10, what="the first process's run")
+        wait_for(lambda: dash.alive[-1] == ("r1:loop", False), 10, what="the machine seen gone")
+        with ZenohRobot("r1", connect=[endpoint]) as again:
+            own = run_on(again, slow_loop(4, 0.0))
+            wait_for(lambda: dash.status("r1:loop").last_seq == own[-1]["seq"], 10,
+                     what=lambda: "the new run: %r" % [(e["kind"], e["seq"]) for e in dash.events[-5:]])
+            assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
     finally:
         dash.watcher.close()
 

@@ -57,6 +57,7 @@ def main(args: argparse.Namespace) -> int:
     """Physics, action servers, the task machine, its recording, and unless headless the dashboard
     with the 3D view; until the episodes are done, Ctrl-C or SIGTERM. Everything is undone on exit."""
     import fsm
+    from fsm.control.handle import MachineHandle
     from fsm.logfiles.recorder import Recorder
     from sim.demo import SimDemo
     from sim.pose import PoseTap
@@ -69,7 +70,7 @@ def main(args: argparse.Namespace) -> int:
     machine = demo.build_machine()
     recorder = Recorder(record_path)
     rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
-    robot = zenoh_robot(args)
+    robot = zenoh_robot(args, can_start=False)
     if robot is not None:
         fsm.attach(machine, robot, name=MACHINE_NAME)
 
@@ -84,14 +85,18 @@ def main(args: argparse.Namespace) -> int:
     hold = threading.Event()
     server = None
     try:
-        if not args.headless:
+        if args.headless:
+            handle = MachineHandle(machine, rep, False, holder=hold.set)  # no loop waits for a start: it ends
+        else:
             scene = demo.scene
             server = start_server(args, scene_url=scene.url if scene is not None else None,
                                   show_pose=scene.show_pose if scene is not None else None)
-            server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set, holder=hold.set,
-                                 recording=record_path)
+            handle = server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set,
+                                          holder=hold.set, recording=record_path).handle
             print("fsmscope demo: open %s" % server.url, flush=True)
             announce_viewer(args, server)
+        if robot is not None:  # the dashboards on Zenoh take the same controls as this one
+            robot.take_controls(handle)
         print("fsmscope demo: recording to %s" % record_path, flush=True)
     except BaseException:
         demo.close()

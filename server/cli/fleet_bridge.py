@@ -2,19 +2,27 @@
 (``fleet.robot.ZenohRobot``); ``serve`` shows the fleet's machines in the dashboard. A ``fleet.watcher.FleetWatcher``
 follows every robot's machines on Zenoh; what it delivers goes through the hub's ingest door (each
 event checked against the schema, as a publisher's are) on the server's event loop, and a machine
-whose liveliness token is withdrawn is shown disconnected (``connected: false``) until it is back."""
+whose liveliness token is withdrawn is shown disconnected (``connected: false``) until it is back.
+A machine whose robot takes controls gets a ``RemoteHandle`` (server/remote_control.py) whose link
+is a ``FleetLink``: each control is a Zenoh query carrying the robot's token (fleet/control.py)."""
 
 from __future__ import annotations
 
 import argparse
+import os
+import secrets
 import sys
 from typing import TYPE_CHECKING
+
+from fsm.control.handle import ControlError
+
+from ..remote_control import RemoteHandle, not_connected, taken
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
     from fleet.watcher import FleetWatcher
 
-    from ..hub import Hub
+    from ..hub import Hub, MachineEntry
 
 
 def add_zenoh_arguments(parser: argparse.ArgumentParser, publish: bool) -> None:
@@ -31,22 +39,81 @@ def add_zenoh_arguments(parser: argparse.ArgumentParser, publish: bool) -> None:
                                  "a robot's, or a zenohd router's); none: only --zenoh-listen and --zenoh-scouting")
     parser.add_argument("--zenoh-listen", action="append", default=[], metavar="ENDPOINT",
                         help="with --zenoh: also listen on this endpoint, for sessions that connect here")
+    parser.add_argument("--zenoh-token", action="append", default=[], metavar="[ROBOT=]TOKEN",
+                        help=("with --zenoh: the token the robot's controls must carry (default: $%s; none: a new "
+                              "one, printed)" % TOKEN_ENV) if publish else
+                             ("with --zenoh: the token to control the robots' machines with; ROBOT=TOKEN for one "
+                              "robot's (default: $%s; none: the fleet is watched, not controlled)" % TOKEN_ENV))
     parser.add_argument("--zenoh-mode", choices=("peer", "client"), default="peer",
                         help="with --zenoh: peer (default), or client of a zenohd router")
     parser.add_argument("--zenoh-scouting", action="store_true",
                         help="with --zenoh: find the others on the LAN by multicast (off unless asked)")
 
 
-def zenoh_robot(args: argparse.Namespace) -> ZenohRobot | None:
-    """With ``--zenoh ROBOT``: the observer that publishes machines as that robot's; else None."""
+TOKEN_ENV = "FSMSCOPE_ZENOH_TOKEN"
+
+
+def zenoh_tokens(args: argparse.Namespace) -> dict[str | None, str]:
+    """The tokens of ``--zenoh-token`` by robot (None: any robot's), with $FSMSCOPE_ZENOH_TOKEN for any."""
+    tokens: dict[str | None, str] = {}
+    if os.environ.get(TOKEN_ENV):
+        tokens[None] = os.environ[TOKEN_ENV]
+    for value in args.zenoh_token:
+        robot, _, token = value.rpartition("=")
+        tokens[robot or None] = token
+    return tokens
+
+
+def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
+    """With ``--zenoh ROBOT``: the observer that publishes machines as that robot's, taking the
+    controls that carry its token; else None."""
     if args.zenoh is None:
         return None
     from fleet.robot import ZenohRobot
 
+    token = zenoh_tokens(args).get(None)
+    if token is None:
+        token = secrets.token_urlsafe(24)
+        print("fsmscope: the token of robot %r's controls: %s (serve --zenoh-token %s=%s)"
+              % (args.zenoh, token, args.zenoh, token), file=sys.stderr, flush=True)
     robot = ZenohRobot(args.zenoh, connect=args.zenoh_connect, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                       scouting=args.zenoh_scouting)
+                       scouting=args.zenoh_scouting, token=token, can_start=can_start)
     print("fsmscope: publishing on Zenoh as robot %r" % args.zenoh, file=sys.stderr, flush=True)
     return robot
+
+
+class FleetLink:
+    """The link (server/remote_control.py) of one fleet machine's ``RemoteHandle``: its controls asked
+    of its robot over Zenoh, with the dashboard's token for that robot."""
+
+    def __init__(self, watcher: FleetWatcher, name: str, token: str, alive: dict[str, bool]) -> None:
+        self.watcher = watcher
+        self.name = name
+        self.robot, _, self.machine = name.partition(":")
+        self.token = token
+        self._alive = alive
+
+    @property
+    def closed(self) -> bool:
+        return not self._alive.get(self.name, False)
+
+    @property
+    def controllable(self) -> dict[str, bool]:
+        offer = self.watcher.controls.get(self.name)
+        return {self.name: offer["can_start"] is True} if offer else {}
+
+    def ask(self, machine: str, action: str, params: dict, client: str) -> dict:
+        """The robot's answer to a control (in a worker thread): as ``IngestLink.ask``."""
+        if self.closed:
+            raise not_connected(machine)
+        answer = self.watcher.ask(self.robot, self.machine, self.token, action, params, client)
+        if answer is None:
+            raise ControlError(504, "robot %r did not answer the control of %r" % (self.robot, self.machine))
+        return taken(machine, answer)
+
+    def post(self, frame: dict) -> None:
+        """A lease frame: the robot is not told (the server's own deadman applies while it reaches the
+        robot; docs/fleet.md says what a robot does when the dashboard is gone)."""
 
 
 def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
@@ -55,6 +122,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
 
     loop = hub.loop
     alive: dict[str, bool] = {}
+    tokens = zenoh_tokens(args)
 
     def ingest(event: dict) -> None:
         problem = hub.ingest(event, "ingest")
@@ -63,8 +131,19 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
                   file=sys.stderr, flush=True)
             return
         entry = hub.get(event["machine"])
-        if entry is not None:
-            entry.connected = alive.get(entry.name, True)
+        if entry is None:
+            return
+        entry.connected = alive.get(entry.name, True)
+        if entry.remote is None and event["kind"] == "snapshot":
+            bind(entry)
+
+    def bind(entry: MachineEntry) -> None:
+        """Its controls go to its robot when the robot takes them and this dashboard has its token."""
+        robot = entry.name.partition(":")[0]
+        token = tokens.get(robot, tokens.get(None))
+        if token is not None and watcher.controls.get(entry.name):
+            entry.remote = RemoteHandle(entry)
+            entry.remote.bind(FleetLink(watcher, entry.name, token, alive))
 
     def seen(name: str, up: bool) -> None:
         alive[name] = up

@@ -5,12 +5,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from .fleet_bridge import add_zenoh_arguments, zenoh_robot
 from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
+    from fleet.robot import ZenohRobot
+
     from ..runner import Runner
 
 HELP = "run a SMACH-style script and record every machine it executes"
@@ -37,15 +39,15 @@ def main(args: argparse.Namespace) -> int:
     from ..runner import Runner
 
     runner = Runner(args.script, list(args.extra), args.record)
-    robot = zenoh_robot(args)
+    robot = zenoh_robot(args, can_start=True)
     if robot is not None:
         runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
     if args.no_serve:
         return runner.run()
-    return run_with_dashboard(args, runner)
+    return run_with_dashboard(args, runner, robot)
 
 
-def run_with_dashboard(args: argparse.Namespace, runner: Runner) -> int:
+def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRobot | None = None) -> int:
     """Serve every machine the script runs; keep serving afterwards unless --exit, or unless a
     signal (Ctrl-C, SIGTERM) ended the script: one signal stops everything."""
     # The script's states run in this process's main thread, the server in others: a state that
@@ -54,8 +56,13 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner) -> int:
     sys.setswitchinterval(SWITCH_INTERVAL)
     srv = start_server(args)
     hub = srv.hub
-    runner.on_machine.append(lambda name, container: hub.add_local(container, name=name, can_start=True,
-                                                                   recording=runner.record_path))
+
+    def serve(name: str, container: Any) -> None:
+        entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path)
+        if robot is not None:  # one handle takes the controls from either side
+            robot.take_controls(entry.handle)
+
+    runner.on_machine.append(serve)
     runner.keep_open = True  # runs started from the dashboard after the script ends are recorded too
     print("fsmscope: dashboard at %s" % srv.url, file=sys.stderr, flush=True)
     announce_viewer(args, srv)

@@ -1,0 +1,84 @@
+"""Controls across the network (fleet/control.py), over real Zenoh sessions on the loopback: the
+robot's process checks the token itself, applies the control, records it in its own stream, and
+answers with the event it caused; nothing without the robot's token controls its machine."""
+
+from __future__ import annotations
+
+import threading
+
+import fsm
+import pytest
+from fleet_support import free_endpoint, slow_loop
+
+from fleet.robot import ZenohRobot
+from fleet.watcher import FleetWatcher
+from server.testing.polling import wait_for
+
+TOKEN = "the-robots-token"
+
+
+@pytest.fixture
+def fleet():
+    """A dashboard's watcher and robot r1 (started with TOKEN) whose machine "loop" runs ticks of 20 ms
+    until preempted; yields (watcher, robot, the events of the robot's own stream)."""
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    endpoint = free_endpoint()
+    watcher = FleetWatcher(lambda event: None, lambda name, up: None, listen=[endpoint])
+    robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
+    sm = slow_loop(100_000, 0.02)
+    own: list[dict] = []
+    fsm.attach(sm, robot, name="loop")
+    fsm.attach(sm, own.append)
+    runner = threading.Thread(target=sm.execute, daemon=True)
+    runner.start()
+    wait_for(lambda: watcher.controls.get("r1:loop"), 10, what="the robot's machine joined, taking controls")
+    try:
+        yield watcher, robot, own
+    finally:
+        sm.request_preempt()
+        runner.join(10)
+        robot.close()
+        watcher.close()
+
+
+def controls_of(events: list[dict]) -> list[dict]:
+    return [e for e in events if e["kind"] == "control"]
+
+
+def test_a_control_with_the_robots_token_is_applied_recorded_and_answered_with_its_event(fleet):
+    watcher, robot, own = fleet
+    answer = watcher.ask("r1", "loop", TOKEN, "preempt", {"reason": "from the fleet page"}, "operator")
+    assert answer["status"] == 202
+    [control] = [e for e in controls_of(own) if e["seq"] == answer["seq"]]
+    assert (control["action"], control["result"], control["client"], control["reason"]) == (
+        "preempt", "accepted", "operator", "from the fleet page")
+
+
+def test_a_control_with_a_wrong_token_is_refused_by_the_robot(fleet):
+    watcher, robot, own = fleet
+    answer = watcher.ask("r1", "loop", "not-" + TOKEN, "preempt", {}, "intruder")
+    assert answer == {"status": 403, "detail": "wrong token for this robot's controls"}
+    assert robot.controls.refused == 1
+    assert controls_of(own) == []
+
+
+def test_a_control_the_machine_refuses_is_answered_with_why(fleet):
+    watcher, robot, own = fleet
+    answer = watcher.ask("r1", "loop", TOKEN, "start", {}, "operator")
+    assert answer["status"] == 409 and "cannot re-run" in answer["detail"]
+    assert [(e["action"], e["result"]) for e in controls_of(own)] == [("start", "this process cannot re-run the machine")]
+
+
+def test_a_robot_started_without_a_token_takes_no_control():
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    endpoint = free_endpoint()
+    with FleetWatcher(lambda event: None, lambda name, up: None, listen=[endpoint]) as watcher, \
+            ZenohRobot("r1", connect=[endpoint]) as robot:
+        sm = slow_loop(3, 0.0)
+        fsm.attach(sm, robot, name="loop")
+        sm.execute()
+        robot.flush()
+        wait_for(lambda: "r1:loop" in watcher.controls, 10, what="the machine joined")
+        assert watcher.controls["r1:loop"] is None  # the dashboard is told: it shows no control
+        answer = watcher.ask("r1", "loop", "", "preempt", {}, "operator")
+        assert answer["status"] == 403 and "without a control token" in answer["detail"]

@@ -9,6 +9,8 @@ from typing import Sequence
 
 import zenoh
 
+LEASE_MS = 3000  # a link silent this long is dropped: the machines behind it are seen gone (Zenoh: 10 s)
+
 
 def session_config(connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
                    scouting: bool = False) -> zenoh.Config:
@@ -19,6 +21,7 @@ def session_config(connect: Sequence[str] = (), listen: Sequence[str] = (), mode
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps(mode))
     config.insert_json5("scouting/multicast/enabled", json.dumps(scouting))
+    config.insert_json5("transport/link/tx/lease", json.dumps(LEASE_MS))
     if connect:
         config.insert_json5("connect/endpoints", json.dumps(list(connect)))
     if listen:

@@ -40,7 +40,14 @@ def control_key(robot: str, machine: str) -> str:
     return machine_key(robot, machine) + "/control"
 
 
+def dashboard_key(session_id: str) -> str:
+    """A dashboard's liveliness token: a robot whose machine it holds a lease on applies the deadman
+    when it is gone (fleet/control.py). Outside ``fsmscope/``: no dashboard is taken for a machine."""
+    return "%s-dashboards/%s" % (PREFIX, chunk(session_id, "dashboard"))
+
+
 ALL_MACHINES = PREFIX + "/*/*"
+ALL_DASHBOARDS = PREFIX + "-dashboards/*"
 ALL_EVENTS = PREFIX + "/*/*/events"
 
 

@@ -17,7 +17,8 @@ bounded queue: a batch that finds it full is dropped, and filled from history af
 the watcher's handles the queue in order, asks the queries and delivers.
 
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
-sends a control to the machine's robot (fleet/control.py).
+sends a control to the machine's robot (fleet/control.py). The watcher's liveliness token
+(``fsmscope-dashboards/<session>``) tells robots whose machines it leases that it is there.
 """
 
 from __future__ import annotations
@@ -60,6 +61,8 @@ class FleetWatcher:
         self.gaps_filled = 0
         self.snapshots = 0
         self.dropped = 0  # batches that found the queue full
+        self.id = str(self.session.zid())
+        self._presence = self.session.liveliness().declare_token(keys.dashboard_key(self.id))
         self._thread = threading.Thread(target=self._work, name="fsmscope-fleet", daemon=True)
         self._thread.start()
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
@@ -77,6 +80,7 @@ class FleetWatcher:
         if self._closed:
             return
         self._closed = True
+        self._presence.undeclare()
         self._tokens.undeclare()
         self._events.undeclare()
         self._queue.put(None)

@@ -35,7 +35,8 @@ import time
 import urllib.parse
 from typing import Any
 
-from fsm.control.frames import answer, apply_deadman, lease_of
+from fsm.control.deadman import Deadmen
+from fsm.control.frames import answer
 from fsm.control.handle import MachineHandle
 from fsm.observation import closing, introspection, schema
 from fsm.observation.encoding import dumps, loads
@@ -80,10 +81,7 @@ class Publisher:
         self._controls: queue.Queue[tuple[int, dict] | None] = queue.Queue()
         self._worker: threading.Thread | None = None
         self._answers: collections.deque[tuple[int, str, int, dict]] = collections.deque()
-        self._deadman_lock = threading.Lock()
-        self._leases: dict[str, tuple[float, str]] = {}  # machine: (after, action) while a lease is held
-        self._outage = 0  # bumped at each connect: a deadman armed for an earlier outage does nothing
-        self._deadmen: list[threading.Timer] = []
+        self._deadmen = Deadmen(self._handles, DEADMAN_CLIENT, "the connection to the dashboard")
         self.connected = threading.Event()
         self.sent = 0
         self.connects = 0
@@ -121,7 +119,7 @@ class Publisher:
             self.flush(max(0.0, deadline - time.monotonic()))
         self._stop.set()
         self._wake.set()
-        self._disarm()
+        self._deadmen.back(forget=True)
         if self._worker is not None:
             self._controls.put(None)
         if self._thread is not None and self._thread is not threading.current_thread():
@@ -180,14 +178,14 @@ class Publisher:
             delay = 0.1
             self._serve(ws)
             if not self._stop.is_set():
-                self._arm()
+                self._deadmen.lost()
 
     def _serve(self, ws: Any) -> None:
         """One connection: send events and answers until it is lost or the publisher stops."""
         self.connects += 1
         connection = self.connects
         lost = threading.Event()
-        self._disarm()
+        self._deadmen.back(forget=True)  # the server says its leases again
         if self._worker is None:
             self._worker = threading.Thread(target=self._work, name="fsmscope-publisher-controls", daemon=True)
             self._worker.start()
@@ -265,14 +263,8 @@ class Publisher:
                              % (frame.get("seq"), frame.get("machine"), frame.get("reason")))
         elif kind == "control":
             self._controls.put((connection, frame))
-        elif kind == "lease":
-            said = lease_of(frame)
-            if said is not None and connection == self.connects:  # not a late frame of a connection since lost
-                with self._deadman_lock:
-                    if said[1] is None:
-                        self._leases.pop(said[0], None)
-                    else:
-                        self._leases[said[0]] = said[1]
+        elif kind == "lease" and connection == self.connects:  # not a late frame of a connection since lost
+            self._deadmen.said(frame)
 
     # The control worker: applies controls in the order they came, off the sender and the machine.
     def _work(self) -> None:
@@ -289,31 +281,3 @@ class Publisher:
             due = handle.reporter.last_seq if handle is not None else 0
             self._answers.append((connection, machine, due, reply))
             self._wake.set()
-
-    # The deadman.
-    def _arm(self) -> None:
-        """The connection is lost: each machine whose lease is held gets its deadman's delay to reconnect."""
-        with self._deadman_lock:
-            for machine, (after, action) in self._leases.items():
-                timer = threading.Timer(after, self._deadman, (self._outage, machine, after, action))
-                timer.daemon = True
-                self._deadmen.append(timer)
-                timer.start()
-
-    def _disarm(self) -> None:
-        """Connected again (or closing): no deadman fires, and the server says the leases again."""
-        with self._deadman_lock:
-            self._outage += 1
-            for timer in self._deadmen:
-                timer.cancel()
-            self._deadmen = []
-            self._leases.clear()
-
-    def _deadman(self, outage: int, machine: str, after: float, action: str) -> None:
-        with self._deadman_lock:
-            if outage != self._outage or self._stop.is_set():
-                return
-        handle = self._handles.get(machine)
-        if handle is not None:
-            apply_deadman(handle, action, DEADMAN_CLIENT, "the connection to the dashboard was lost for %.1f s" % after,
-                          {"after": after})

@@ -82,3 +82,14 @@ def test_a_robot_started_without_a_token_takes_no_control():
         assert watcher.controls["r1:loop"] is None  # the dashboard is told: it shows no control
         answer = watcher.ask("r1", "loop", "", "preempt", {}, "operator")
         assert answer["status"] == 403 and "without a control token" in answer["detail"]
+
+
+def test_the_robot_applies_the_deadman_when_the_dashboard_holding_the_lease_is_gone(fleet):
+    watcher, robot, own = fleet
+    lease = {"held": True, "after": 0.3, "action": "preempt", "dashboard": watcher.id}
+    assert watcher.ask("r1", "loop", TOKEN, "lease", lease, "operator") == {"status": 200}
+    watcher.close()
+    wait_for(lambda: any(e["kind"] == "terminate" for e in own), 10, what="the run ended by the deadman")
+    assert [(e["action"], e["client"]) for e in controls_of(own)] == [("deadman", "robot"), ("preempt", "robot")]
+    [deadman] = [e for e in controls_of(own) if e["action"] == "deadman"]
+    assert deadman["params"] == {"after": 0.3, "then": "preempt"} and watcher.id in deadman["reason"]

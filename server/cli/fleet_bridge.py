@@ -12,6 +12,7 @@ import argparse
 import os
 import secrets
 import sys
+import threading
 from typing import TYPE_CHECKING
 
 from fsm.control.handle import ControlError
@@ -112,8 +113,18 @@ class FleetLink:
         return taken(machine, answer)
 
     def post(self, frame: dict) -> None:
-        """A lease frame: the robot is not told (the server's own deadman applies while it reaches the
-        robot; docs/fleet.md says what a robot does when the dashboard is gone)."""
+        """A lease frame (any thread, never waits): the robot is told, naming this dashboard's session,
+        so that it applies the deadman itself when this dashboard is gone (fleet/control.py)."""
+        params = {key: frame[key] for key in ("held", "after", "action")}
+        params["dashboard"] = self.watcher.id
+        threading.Thread(target=self._tell, args=(params,), name="fsmscope-fleet-lease", daemon=True).start()
+
+    def _tell(self, params: dict) -> None:
+        answer = self.watcher.ask(self.robot, self.machine, self.token, "lease", params, "dashboard")
+        if answer is None or answer.get("status") != 200:
+            print("fsmscope serve: robot %r was not told of the lease on %r: %s" % (
+                self.robot, self.machine, "no answer" if answer is None else answer.get("detail")),
+                file=sys.stderr, flush=True)
 
 
 def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
@@ -150,6 +161,8 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
         entry = hub.get(name)
         if entry is not None:
             entry.connected = up
+            if up and entry.remote is not None and entry.remote.link is not None:
+                entry.remote.bind(entry.remote.link)  # the lease said again: its process may be a new one
 
     watcher = FleetWatcher(lambda event: loop.call_soon_threadsafe(ingest, event),
                            lambda name, up: loop.call_soon_threadsafe(seen, name, up),

@@ -24,7 +24,8 @@ from .hub import Hub
 from .lease import Deadman, Leases
 from .lease_control import LeaseControl
 from .middleware import SecurityMiddleware
-from .routes import control, debug, history, ingest, lease, machines, pages, scene, stream, timeline
+from .overview import Overview
+from .routes import control, debug, history, ingest, lease, machines, overview, pages, scene, stream, timeline
 from .settings import Settings
 
 
@@ -51,13 +52,14 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     app.state.settings = Settings(token=token, viewer_token=viewer_token, host=host, port=port, scene_url=scene_url)
     app.state.hub = hub
     app.state.leases = leases
+    app.state.overview = Overview(hub)
     app.state.show_pose = show_pose
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(Exception, _unexpected_error)
     app.add_exception_handler(ControlError, _control_error)
     app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")  # for pages.docs
-    for module in (pages, machines, history, timeline, control, debug, lease, scene, stream, ingest):
+    for module in (pages, machines, overview, history, timeline, control, debug, lease, scene, stream, ingest):
         app.include_router(module.router)
     root = pages.static_dir()
     if root and os.path.isdir(root):

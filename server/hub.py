@@ -41,6 +41,7 @@ class MachineEntry(Feed):
         self.source = source
         self.rejected = 0  # events refused at the door (ingest) for not fitting the schema
         self.connected: bool | None = None  # ingest: whether its publisher is connected (None: not ingested)
+        self.robot: str | None = None  # a fleet machine's robot (its name is "<robot>:<machine>")
         self.handle: MachineHandle | None = None  # local machines only
         self.remote: RemoteHandle | None = None  # ingested ones whose publisher takes controls (remote_control.py)
         self.replay: dict | None = None  # replayed from a log: {"speed": the page's initial play speed}

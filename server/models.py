@@ -68,6 +68,23 @@ class MachineInfo(BaseModel):
                                          "(source replay): how the page plays it; null for the others")
 
 
+class Tile(BaseModel):
+    """A machine's tile on the fleet overview (server/overview.py)."""
+    name: str = Field(description="the dashboard's name of the machine (a robot's: robot:machine)")
+    robot: Optional[str] = Field(default=None, description="the robot publishing it on Zenoh (null for the others)")
+    machine: str = Field(description="its name on its robot (its name, for the others)")
+    source: Literal[SOURCES]  # type: ignore[valid-type]
+    state: Literal["running", "failed", "done", "idle", "gone"]
+    outcome: Optional[str] = None
+    error: Optional[str] = Field(default=None, description="the exception type of a failed run")
+    active: list[str] = Field(description="the full paths of its active states (leaves)")
+    rate: float = Field(description="events per second over the last 5 s, as the server received them")
+    last_seq: int
+    last_seen: Optional[float] = Field(default=None, description="when the server saw its newest event "
+                                       "(Unix time, the server's clock; null before any)")
+    connected: bool = Field(description="false when the process that publishes it has gone away")
+
+
 class Transition(BaseModel):
     model_config = ConfigDict(populate_by_name=True)
 

@@ -45,6 +45,9 @@ async function request(method, url, body, accept = "json") {
 
 const machine = (name) => "/api/machines/" + encodeURIComponent(name);
 
+/** The websocket address of `path` on this page's server. */
+const wsUrl = (path) => `${location.protocol === "https:" ? "wss:" : "ws:"}//${location.host}${path}`;
+
 const controlListeners = new Set();
 
 /** A control of machine `name` (one the lease covers): the listeners hear of each one accepted. */
@@ -101,8 +104,9 @@ export const api = {
   leaseWatch: (name) => ({ lease: machine(name) + "/lease", beat: machine(name) + "/lease/beat", headers: pageHeaders() }),
   releaseLease: (name) => request("DELETE", machine(name) + "/lease"),
   streamUrl(name, since) {
-    const proto = location.protocol === "https:" ? "wss:" : "ws:";
     const qs = since ? "?since=" + encodeURIComponent(since) : "";
-    return `${proto}//${location.host}${machine(name)}/stream${qs}`;
+    return wsUrl(`${machine(name)}/stream${qs}`);
   },
+  /** The fleet overview's stream (fleet.js). */
+  overviewUrl: () => wsUrl("/api/overview/stream"),
 };

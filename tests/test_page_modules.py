@@ -1,4 +1,4 @@
-"""The page names every ES module app.js needs in <link rel="modulepreload">: the browser then fetches
+"""A page names every ES module its script needs in <link rel="modulepreload">: the browser then fetches
 them all at once instead of one level of imports after another (about 0.6 s of a page's first graph,
 bench/big_machine_browser.py). Dynamic imports (``import(...)``) are loaded when used and not preloaded."""
 
@@ -25,4 +25,9 @@ def imported_by(module: str) -> set[str]:
 def test_the_page_preloads_exactly_the_modules_app_js_imports():
     preloaded = PRELOAD.findall((STATIC / "index.html").read_text())
     assert sorted(preloaded) == sorted(imported_by("app.js"))
+
+
+def test_the_fleet_page_preloads_exactly_the_modules_fleet_js_imports():
+    preloaded = PRELOAD.findall((STATIC / "fleet.html").read_text())
+    assert sorted(preloaded) == sorted(imported_by("fleet.js"))
 

@@ -145,6 +145,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
         if entry is None:
             return
         entry.connected = alive.get(entry.name, True)
+        entry.robot = entry.name.partition(":")[0]
         if entry.remote is None and event["kind"] == "snapshot":
             bind(entry)
 

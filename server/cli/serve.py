@@ -27,6 +27,8 @@ def main(args: argparse.Namespace) -> int:
 
         start_fleet(args, srv.hub)
     print("fsmscope: serving the dashboard at %s" % srv.url, file=sys.stderr)
+    if args.zenoh is not None:
+        print("fsmscope: the fleet overview at %s" % (srv.base_url + "/fleet" + ("?token=" + srv.token if srv.token else "")), file=sys.stderr)
     announce_viewer(args, srv)
     print("fsmscope: other processes publish with server.publisher.Publisher(%r, %r); Ctrl-C stops"
           % (srv.base_url, srv.token), file=sys.stderr, flush=True)

@@ -31,13 +31,23 @@ def static_dir() -> str | None:
     return list(spec.submodule_search_locations)[0]
 
 
+def _page(filename: str) -> Response:
+    """A page of the dashboard: it holds no data; it takes the token from its URL (static/token.js)."""
+    root = static_dir()
+    if root and os.path.isfile(os.path.join(root, filename)):
+        return FileResponse(os.path.join(root, filename), headers={"Cache-Control": "no-cache"})
+    return HTMLResponse(_PLACEHOLDER)
+
+
 @router.get("/", include_in_schema=False)
 async def index() -> Response:
-    """The page holds no data; it takes the token from its URL (static/token.js)."""
-    root = static_dir()
-    if root and os.path.isfile(os.path.join(root, "index.html")):
-        return FileResponse(os.path.join(root, "index.html"), headers={"Cache-Control": "no-cache"})
-    return HTMLResponse(_PLACEHOLDER)
+    return _page("index.html")
+
+
+@router.get("/fleet", include_in_schema=False)
+async def fleet() -> Response:
+    """The fleet overview: a tile per machine (static/fleet.js)."""
+    return _page("fleet.html")
 
 
 @router.get("/docs", include_in_schema=False)

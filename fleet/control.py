@@ -32,6 +32,7 @@ from fsm.control.handle import MachineHandle
 from fsm.observation.encoding import dumps, loads
 
 from . import keys
+from .query import first_reply
 
 QUEUE = 256  # control queries waiting for the robot's worker before new ones are refused (503)
 DEADMAN_CLIENT = "robot"  # the client of what the robot does on its own
@@ -64,8 +65,12 @@ class RobotControls:
         self._session = session
         return session.declare_queryable(key, lambda query: self._take(machine, query))
 
-    def close(self) -> None:
+    def close(self, timeout: float) -> None:
+        """Answer the controls already asked (a preempt that ends the process's script is answered
+        before the process ends), then stop."""
         self._queries.put(None)
+        if self._thread is not threading.current_thread():
+            self._thread.join(timeout)
         with self._lock:
             for deadmen in self._deadmen.values():
                 deadmen.back(forget=True)
@@ -156,12 +161,11 @@ def ask(session: zenoh.Session, key: str, token: str, action: str, params: dict,
         timeout: float) -> dict | None:
     """The dashboard's side: the robot's answer to a control (a dict with its ``status``), or None when
     no robot answered within ``timeout`` seconds."""
-    for reply in session.get(key, payload=request(token, action, params, client), timeout=timeout):
-        if reply.ok is None:
-            continue
-        try:
-            fields = loads(reply.ok.payload.to_bytes())
-        except ValueError:
-            fields = None
-        return fields if type(fields) is dict else {"status": 502, "detail": "the robot's answer is not a JSON object"}
-    return None
+    reply = first_reply(session, key, timeout, request(token, action, params, client))
+    if reply is None:
+        return None
+    try:
+        fields = loads(reply)
+    except ValueError:
+        fields = None
+    return fields if type(fields) is dict else {"status": 502, "detail": "the robot's answer is not a JSON object"}

@@ -142,9 +142,9 @@ class ZenohRobot:
         self._handoff.wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join(timeout)
+        self.controls.close(timeout)
         for machine in self._machines.values():
             machine.close()
-        self.controls.close()
         self.session.close()
         closing.closed(self)
 

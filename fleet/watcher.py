@@ -34,6 +34,7 @@ from fsm.observation.encoding import loads
 
 from . import control, keys
 from .config import session_config
+from .query import first_reply
 
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
 QUEUE = 10_000  # samples waiting for the watcher's thread before new ones are dropped
@@ -152,10 +153,8 @@ class FleetWatcher:
 
     def _state(self, robot: str, machine: str) -> dict | None:
         """The machine's state answer (its snapshot, controls and origin); None when none came."""
-        for reply in self.session.get(keys.state_key(robot, machine), timeout=QUERY_TIMEOUT):
-            if reply.ok is not None:
-                return loads(reply.ok.payload.to_bytes())
-        return None
+        answer = first_reply(self.session, keys.state_key(robot, machine), QUERY_TIMEOUT)
+        return None if answer is None else loads(answer)
 
     def _join(self, robot: str, machine: str) -> None:
         """A machine seen alive: new, or back after a drop (what it missed), or from a new process."""
@@ -187,16 +186,15 @@ class FleetWatcher:
     def _fill(self, robot: str, machine: str, since: int) -> None:
         """The events from ``since`` on, from the robot's history; a snapshot when it no longer has them."""
         name = fleet_name(robot, machine)
-        for reply in self.session.get(keys.history_key(robot, machine) + "?since=%d" % since, timeout=QUERY_TIMEOUT):
-            if reply.ok is None:
-                continue
-            answer = loads(reply.ok.payload.to_bytes())
-            if not answer["complete"]:
-                self._snapshot(robot, machine)
-                return
-            self._deliver(name, answer["events"])
-            self.gaps_filled += 1
+        reply = first_reply(self.session, keys.history_key(robot, machine) + "?since=%d" % since, QUERY_TIMEOUT)
+        if reply is None:
             return
+        answer = loads(reply)
+        if not answer["complete"]:
+            self._snapshot(robot, machine)
+            return
+        self._deliver(name, answer["events"])
+        self.gaps_filled += 1
 
     def ask(self, robot: str, machine: str, token: str, action: str, params: dict, client: str) -> dict | None:
         """A control for ``robot``'s ``machine``: its robot's answer, None when none came in time."""

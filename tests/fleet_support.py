@@ -1,13 +1,28 @@
-"""Fleet tests' pieces: a free loopback tcp endpoint for Zenoh, a slow loop machine, and a TCP proxy
-whose connections can be cut and let through again (a network drop between a robot and a dashboard)."""
+"""Fleet tests' pieces: a free loopback tcp endpoint for Zenoh, a slow loop machine, a TCP proxy
+whose connections can be cut and let through again (a network drop between a robot and a dashboard),
+and real processes: a dashboard (``fsmscope serve --zenoh``) and robots (``fsmscope run
+robots/patrol.py --zenoh ROBOT``)."""
 
 from __future__ import annotations
 
+import os
+import re
+import signal
 import socket
+import subprocess
+import sys
 import threading
 import time
+from pathlib import Path
 
 import fsm
+import httpx
+
+from fsm.logfiles.log_reader import read_events
+from server.testing.polling import wait_for
+
+ROOT = Path(__file__).resolve().parents[1]
+PATROL = Path(__file__).resolve().parent / "robots" / "patrol.py"
 
 
 def free_endpoint() -> str:
@@ -107,3 +122,70 @@ class Proxy:
     def close(self) -> None:
         self.cut()
         self.server.close()
+
+
+class Dashboard:
+    """``fsmscope serve --zenoh`` in a real process, listening on a Zenoh endpoint of its own."""
+
+    def __init__(self, *options: str) -> None:
+        self.endpoint = free_endpoint()
+        self.proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
+                                      "--zenoh-listen", self.endpoint, *options], cwd=ROOT, stderr=subprocess.PIPE,
+                                     text=True, start_new_session=True)
+        for line in self.proc.stderr:
+            found = re.search(r"serving the dashboard at (http://\S+)", line)
+            if found:
+                break
+        else:
+            raise RuntimeError("the dashboard ended before serving")
+        self.base, self.token = found.group(1).split("/?token=")
+        threading.Thread(target=self.proc.stderr.read, daemon=True).start()  # never blocks on a full pipe
+
+    def machines(self) -> dict[str, dict]:
+        return {m["name"]: m for m in httpx.get(self.base + "/api/machines", params={"token": self.token}).json()}
+
+    def post(self, path: str, body: dict) -> httpx.Response:
+        return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
+
+    def stop(self) -> None:
+        os.killpg(self.proc.pid, signal.SIGINT)
+        self.proc.wait(20)
+
+
+class Robot:
+    """Robot ``name`` in a real process: ``fsmscope run robots/patrol.py --no-serve --zenoh NAME``,
+    connecting to ``endpoint`` and recording to ``log``; ``fail``: its patrol fails on the third scan."""
+
+    def __init__(self, name: str, endpoint: str, token: str, log: Path, fail: bool = False) -> None:
+        self.name, self.endpoint, self.token, self.log, self.fail = name, endpoint, token, log, fail
+        self.proc: subprocess.Popen | None = None
+        self.start()
+
+    def start(self) -> None:
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "server.cli", "run", str(PATROL), "--no-serve", "--record", str(self.log),
+             "--zenoh", self.name, "--zenoh-connect", self.endpoint, "--zenoh-token", self.token,
+             *(["--", "fail"] if self.fail else [])],
+            cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+
+    def kill(self) -> None:
+        """Gone at once, as a robot that loses power: nothing is closed or said."""
+        os.killpg(self.proc.pid, signal.SIGKILL)
+        self.proc.wait(10)
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            try:
+                self.proc.wait(10)
+            except subprocess.TimeoutExpired:
+                self.kill()
+
+    def events(self) -> list[dict]:
+        """What the robot recorded in its own log."""
+        return list(read_events(str(self.log)))
+
+    def ended(self, timeout: float = 15) -> int:
+        """Wait for its script to end; its exit code."""
+        wait_for(lambda: self.proc.poll() is not None, timeout, what="robot %s's script to end" % self.name)
+        return self.proc.returncode

@@ -1,53 +1,25 @@
 """`fsmscope serve --zenoh` in a real process follows a robot's machine published on Zenoh (a real
-session on the loopback): the machine appears in /api/machines with the robot's state, and is shown
-disconnected when the robot leaves."""
+session on the loopback): the machine appears in /api/machines with the robot's state, is shown
+disconnected when the robot leaves, shows every event the robot recorded even across a network cut,
+and takes the dashboard's controls when it holds the robot's token."""
 
 from __future__ import annotations
 
-import os
-import re
-import signal
 import subprocess
 import sys
 import threading
+import time
 
 import fsm
 import httpx
 import pytest
-from fleet_support import free_endpoint, slow_loop
+from fleet_support import ROOT, Dashboard, Proxy, Robot, free_endpoint, slow_loop
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from fsm.logfiles.log_reader import read_events
 from server.cli.demo import MACHINE_NAME
 from server.testing.polling import wait_for
-
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-
-
-class Dashboard:
-    """``fsmscope serve --zenoh`` in a real process, listening on a Zenoh endpoint of its own."""
-
-    def __init__(self, *options: str) -> None:
-        self.endpoint = free_endpoint()
-        self.proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
-                                      "--zenoh-listen", self.endpoint, *options], cwd=ROOT, stderr=subprocess.PIPE,
-                                     text=True, start_new_session=True)
-        for line in self.proc.stderr:
-            found = re.search(r"serving the dashboard at (http://\S+)", line)
-            if found:
-                break
-        self.base, self.token = found.group(1).split("/?token=")
-
-    def machines(self) -> dict[str, dict]:
-        return {m["name"]: m for m in httpx.get(self.base + "/api/machines", params={"token": self.token}).json()}
-
-    def post(self, path: str, body: dict) -> httpx.Response:
-        return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
-
-    def stop(self) -> None:
-        os.killpg(self.proc.pid, signal.SIGINT)
-        self.proc.wait(20)
 
 
 @pytest.fixture
@@ -62,6 +34,41 @@ def dashboard_with():
     yield start
     for dash in started:
         dash.stop()
+
+
+def history(dash: Dashboard, name: str, since: int) -> list[dict]:
+    """The dashboard's events of machine ``name`` from seq ``since`` on."""
+    events: list[dict] = []
+    while since is not None:
+        page = httpx.get(dash.base + "/api/machines/%s/history" % name,
+                         params={"token": dash.token, "since": since, "limit": 1000}).json()
+        events += page["events"]
+        since = page["next"] if page["more"] else None
+    return events
+
+
+def test_a_robot_process_cut_off_and_back_leaves_no_gap_in_the_dashboard(dashboard_with, tmp_path):
+    dash = dashboard_with("--zenoh-token", "T")
+    proxy = Proxy(dash.endpoint)
+    robot = Robot("r1", proxy.endpoint, "T", tmp_path / "r1.jsonl")
+    try:
+        wait_for(lambda: dash.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol running")
+        first = dash.machines()["r1:patrol"]["last_seq"]
+        proxy.cut()
+        time.sleep(4.0)  # past the link's lease: the dashboard sees the robot gone, and it runs on unseen
+        assert dash.machines()["r1:patrol"]["connected"] is False
+        proxy.restore()
+        wait_for(lambda: dash.machines()["r1:patrol"]["connected"], 20, what="r1:patrol back")
+        answer = dash.post("/api/machines/r1:patrol/preempt", {})
+        assert answer.status_code == 202, answer.text
+        assert robot.ended() == 0
+        own = [e for e in robot.events() if e["seq"] > first]
+        wait_for(lambda: dash.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
+        seen = history(dash, "r1:patrol", first + 1)
+        assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[-3:], own[-3:])
+    finally:
+        robot.stop()
+        proxy.close()
 
 
 def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leaves(dashboard_with):

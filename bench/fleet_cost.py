@@ -28,8 +28,8 @@ WATCHER = """
 import sys, threading
 from fleet.watcher import FleetWatcher
 seen = [0]
-def count(event):
-    seen[0] += 1
+def count(events):
+    seen[0] += len(events)
 FleetWatcher(count, lambda name, up: None, listen=[sys.argv[1]])
 print("listening", flush=True)
 threading.Event().wait()

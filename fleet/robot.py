@@ -43,6 +43,8 @@ from .control import RobotControls
 BUFFER = 100_000  # events waiting for the sender before the oldest are dropped
 RING = 10_000  # events of each machine kept for history queries
 MAX_BATCH = 2000  # events per put
+LINGER = 0.005  # seconds the sender lets events gather after the first (fewer, larger puts: a dashboard
+                # following a fleet pays per put received, not per event)
 CONTROL_SETTLE = 1.0  # seconds a control's answer waits for the events it caused to be put
 
 
@@ -157,7 +159,8 @@ class ZenohRobot:
     def _run(self) -> None:
         wake = self._handoff.wake
         while not self._stop.is_set():
-            wake.wait(0.5)
+            if wake.wait(0.5):
+                self._stop.wait(LINGER)  # the events of the next few ms go with this one's
             wake.clear()
             while self._buf:
                 self._handoff.busy = True

@@ -12,9 +12,11 @@ with the events it missed when its process is the same (its session's id, which 
 carries), with a new snapshot when the process is a new one (its seqs start again).
 
 Each delivered event carries the dashboard's name of the machine, ``<robot>:<machine>``: machines
-of different robots may share a name. Two threads read Zenoh's channels and queue what arrived (a
-bounded queue: a batch that finds it full is dropped, and filled from history after); one thread of
-the watcher's handles the queue in order, asks the queries and delivers.
+of different robots may share a name. Two threads of the watcher's read Zenoh's channels (bounded:
+the events' drops its oldest batch when full, and the gap is filled from history after) and handle
+what they read one at a time, under one lock: deliver, ask the queries. A thread asking a query
+leaves its channel to fill meanwhile; no other hop is taken per batch (each costs a fleet's
+dashboard more than the batch's events do).
 
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
 sends a control to the machine's robot (fleet/control.py). The watcher's liveliness token
@@ -23,7 +25,6 @@ sends a control to the machine's robot (fleet/control.py). The watcher's livelin
 
 from __future__ import annotations
 
-import queue
 import threading
 from typing import Callable, Sequence
 
@@ -37,7 +38,7 @@ from .config import session_config
 from .query import first_reply
 
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
-QUEUE = 10_000  # samples waiting for the watcher's thread before new ones are dropped
+QUEUE = 10_000  # samples waiting in a channel for the watcher's thread before the oldest are dropped
 
 
 def fleet_name(robot: str, machine: str) -> str:
@@ -46,10 +47,10 @@ def fleet_name(robot: str, machine: str) -> str:
 
 
 class FleetWatcher:
-    """Follows every machine of the fleet: ``deliver(event)`` for each snapshot and event (renamed),
-    ``alive(name, bool)`` as machines come and go."""
+    """Follows every machine of the fleet: ``deliver(events)`` for each snapshot and batch of events
+    (renamed, in order: one machine's per call), ``alive(name, bool)`` as machines come and go."""
 
-    def __init__(self, deliver: Callable[[dict], None], alive: Callable[[str, bool], None],
+    def __init__(self, deliver: Callable[[list[dict]], None], alive: Callable[[str, bool], None],
                  connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
                  scouting: bool = False) -> None:
         self.deliver = deliver
@@ -58,14 +59,11 @@ class FleetWatcher:
         self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
         self.controls: dict[str, dict | None] = {}  # machine -> what its robot said of its controls
         self._origins: dict[str, str] = {}  # machine -> the session id of the robot's process
-        self._queue: queue.Queue[tuple[str, str, bytes | bool] | None] = queue.Queue(QUEUE)
+        self._lock = threading.Lock()  # one sample handled at a time, by either reader
         self.gaps_filled = 0
         self.snapshots = 0
-        self.dropped = 0  # batches that found the queue full
         self.id = str(self.session.zid())
         self._presence = self.session.liveliness().declare_token(keys.dashboard_key(self.id))
-        self._thread = threading.Thread(target=self._work, name="fsmscope-fleet", daemon=True)
-        self._thread.start()
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
         # process from ending); the events' channel drops the oldest when full (the gap is filled after).
         self._events = self.session.declare_subscriber(keys.ALL_EVENTS, zenoh.handlers.RingChannel(QUEUE))
@@ -84,8 +82,6 @@ class FleetWatcher:
         self._presence.undeclare()
         self._tokens.undeclare()
         self._events.undeclare()
-        self._queue.put(None)
-        self._thread.join(QUERY_TIMEOUT)
         self.session.close()
         closing.closed(self)
 
@@ -105,51 +101,37 @@ class FleetWatcher:
         except zenoh.ZError:  # the session closed
             pass
 
-    # The readers' threads: queue, never wait.
+    # The readers' threads.
     def _on_token(self, sample: zenoh.Sample) -> None:
         robot, machine = keys.split(str(sample.key_expr))
-        self._put(robot, machine, sample.kind == zenoh.SampleKind.PUT)
+        name = fleet_name(robot, machine)
+        up = sample.kind == zenoh.SampleKind.PUT
+        with self._lock:
+            self.alive(name, up)
+            if up:
+                self._join(robot, machine)
 
     def _on_events(self, sample: zenoh.Sample) -> None:
         robot, machine = keys.split(str(sample.key_expr))
-        self._put(robot, machine, sample.payload.to_bytes())
-
-    def _put(self, robot: str, machine: str, what: bytes | bool) -> None:
-        try:
-            self._queue.put_nowait((robot, machine, what))
-        except queue.Full:
-            self.dropped += 1  # a token change is dropped only with the queue full of batches
-
-    # The watcher's thread.
-    def _work(self) -> None:
-        while True:
-            item = self._queue.get()
-            if item is None:
-                return
-            robot, machine, what = item
-            name = fleet_name(robot, machine)
-            if what is True:
-                self.alive(name, True)
-                self._join(robot, machine)
-            elif what is False:
-                self.alive(name, False)
-            elif name not in self._last:  # not joined: its state did not answer yet (Zenoh had not told it)
+        name = fleet_name(robot, machine)
+        with self._lock:
+            if name not in self._last:  # not joined: its state did not answer yet (Zenoh had not told it)
                 self._snapshot(robot, machine)
-            else:
-                events = loads(what)
-                if events and events[0]["seq"] > self._last[name] + 1:
-                    self._fill(robot, machine, self._last[name] + 1)
-                self._deliver(name, events)
+                return
+            events = loads(sample.payload.to_bytes())
+            if events and events[0]["seq"] > self._last[name] + 1:
+                self._fill(robot, machine, self._last[name] + 1)
+            self._deliver(name, events)
 
     def _deliver(self, name: str, events: list[dict]) -> None:
         last = self._last.get(name, 0)
-        for event in events:
-            if event["seq"] <= last:
-                continue  # delivered already (a history answer and a batch overlap)
+        fresh = [event for event in events if event["seq"] > last]  # not a history answer's overlap
+        if not fresh:
+            return
+        for event in fresh:
             event["machine"] = name
-            self.deliver(event)
-            last = event["seq"]
-        self._last[name] = last
+        self.deliver(fresh)
+        self._last[name] = fresh[-1]["seq"]
 
     def _state(self, robot: str, machine: str) -> dict | None:
         """The machine's state answer (its snapshot, controls and origin); None when none came."""
@@ -179,7 +161,7 @@ class FleetWatcher:
         self._origins[name] = answer["origin"]
         snapshot["machine"] = name
         snapshot["status"]["machine"] = name
-        self.deliver(snapshot)
+        self.deliver([snapshot])
         self._last[name] = snapshot["seq"]
         self.snapshots += 1
 

@@ -148,7 +148,7 @@ class Dashboard:
         return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
 
     def stop(self) -> None:
-        os.killpg(self.proc.pid, signal.SIGINT)
+        os.killpg(self.proc.pid, signal.SIGTERM)  # a SIGINT is ignored by a process started in the background
         self.proc.wait(20)
 
 
@@ -175,7 +175,7 @@ class Robot:
 
     def stop(self) -> None:
         if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGINT)
+            os.killpg(self.proc.pid, signal.SIGTERM)
             try:
                 self.proc.wait(10)
             except subprocess.TimeoutExpired:

@@ -23,7 +23,7 @@ def fleet():
     until preempted; yields (watcher, robot, the events of the robot's own stream)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     endpoint = free_endpoint()
-    watcher = FleetWatcher(lambda event: None, lambda name, up: None, listen=[endpoint])
+    watcher = FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint])
     robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
     sm = slow_loop(100_000, 0.02)
     own: list[dict] = []
@@ -72,7 +72,7 @@ def test_a_control_the_machine_refuses_is_answered_with_why(fleet):
 def test_a_robot_started_without_a_token_takes_no_control():
     fsm.set_loggers(*(lambda msg: None,) * 4)
     endpoint = free_endpoint()
-    with FleetWatcher(lambda event: None, lambda name, up: None, listen=[endpoint]) as watcher, \
+    with FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint]) as watcher, \
             ZenohRobot("r1", connect=[endpoint]) as robot:
         sm = slow_loop(3, 0.0)
         fsm.attach(sm, robot, name="loop")

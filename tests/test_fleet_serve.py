@@ -135,7 +135,7 @@ def watching():
     """(the endpoint a watcher listens on, the events it delivers)."""
     endpoint = free_endpoint()
     seen: list[dict] = []
-    watcher = FleetWatcher(seen.append, lambda name, up: None, listen=[endpoint])
+    watcher = FleetWatcher(seen.extend, lambda name, up: None, listen=[endpoint])
     yield endpoint, seen
     watcher.close()
 

@@ -24,7 +24,7 @@ class Dashboard:
     def __init__(self, **session) -> None:
         self.events: list[dict] = []
         self.alive: list[tuple[str, bool]] = []
-        self.watcher = FleetWatcher(self.events.append, lambda name, up: self.alive.append((name, up)), **session)
+        self.watcher = FleetWatcher(self.events.extend, lambda name, up: self.alive.append((name, up)), **session)
 
     def status(self, name: str) -> Status:
         """The machine's state rebuilt from what was delivered: its last snapshot, then events."""

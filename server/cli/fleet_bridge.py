@@ -9,15 +9,18 @@ is a ``FleetLink``: each control is a Zenoh query carrying the robot's token (fl
 from __future__ import annotations
 
 import argparse
+import asyncio
+import collections
 import os
 import secrets
 import sys
 import threading
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Callable
 
 from fsm.control.handle import ControlError
 
 from ..remote_control import RemoteHandle, not_connected, taken
+from .serving import SWITCH_INTERVAL
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -127,26 +130,61 @@ class FleetLink:
                 file=sys.stderr, flush=True)
 
 
+LINGER = 0.002  # seconds the loop lets the fleet's calls gather before it runs them
+
+
+class LoopInbox:
+    """What the watcher's thread hands to the event loop, in order: calls queued, and run together
+    ``LINGER`` after the first of them (a fleet's thousands of batches a second wake the loop a few
+    hundred times, not once per batch: each wake costs it more than ingesting an event does)."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
+        self.loop = loop
+        self._calls: collections.deque[tuple[Callable[..., None], tuple]] = collections.deque()
+        self._lock = threading.Lock()
+        self._scheduled = False
+
+    def post(self, call: Callable[..., None], *args: object) -> None:
+        """From any thread: ``call(*args)`` on the loop, after those posted before it."""
+        with self._lock:
+            self._calls.append((call, args))
+            if self._scheduled:
+                return
+            self._scheduled = True
+        self.loop.call_soon_threadsafe(self.loop.call_later, LINGER, self._run)
+
+    def _run(self) -> None:
+        with self._lock:
+            calls, self._calls = self._calls, collections.deque()
+            self._scheduled = False
+        for call, args in calls:
+            call(*args)
+
+
 def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
     """The watcher, feeding ``hub`` on its loop until the process ends."""
     from fleet.watcher import FleetWatcher
 
-    loop = hub.loop
+    # The watcher's readers and the event loop take turns holding the GIL: at Python's default 5 ms
+    # an event waited up to that long at each turn (bench/fleet_dashboard.py).
+    sys.setswitchinterval(SWITCH_INTERVAL)
+    inbox = LoopInbox(hub.loop)
     alive: dict[str, bool] = {}
     tokens = zenoh_tokens(args)
 
-    def ingest(event: dict) -> None:
-        problem = hub.ingest(event, "ingest")
-        if problem:
-            print("fsmscope serve: refused an event of %s from Zenoh: %s" % (event.get("machine"), problem),
-                  file=sys.stderr, flush=True)
-            return
-        entry = hub.get(event["machine"])
+    def ingest(events: list[dict]) -> None:
+        """One machine's events, in order."""
+        for event in events:
+            problem = hub.ingest(event, "ingest")
+            if problem:
+                print("fsmscope serve: refused an event of %s from Zenoh: %s" % (event.get("machine"), problem),
+                      file=sys.stderr, flush=True)
+        entry = hub.get(events[0]["machine"])
         if entry is None:
             return
         entry.connected = alive.get(entry.name, True)
         entry.robot = entry.name.partition(":")[0]
-        if entry.remote is None and event["kind"] == "snapshot":
+        if entry.remote is None and events[0]["kind"] == "snapshot":
             bind(entry)
 
     def bind(entry: MachineEntry) -> None:
@@ -165,8 +203,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
             if up and entry.remote is not None and entry.remote.link is not None:
                 entry.remote.bind(entry.remote.link)  # the lease said again: its process may be a new one
 
-    watcher = FleetWatcher(lambda event: loop.call_soon_threadsafe(ingest, event),
-                           lambda name, up: loop.call_soon_threadsafe(seen, name, up),
+    watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),
                            connect=args.zenoh, listen=args.zenoh_listen, mode=args.zenoh_mode,
                            scouting=args.zenoh_scouting)
     print("fsmscope: following the fleet on Zenoh (%s)" % ", ".join(

@@ -8,7 +8,7 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from .fleet_bridge import add_zenoh_arguments, zenoh_robot
-from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
+from .serving import SWITCH_INTERVAL, add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -17,7 +17,6 @@ if TYPE_CHECKING:
 
 HELP = "run a SMACH-style script and record every machine it executes"
 PASSES_ARGUMENTS_ON = True
-SWITCH_INTERVAL = 0.0005  # s a thread may hold the GIL while another waits for it
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:

@@ -72,6 +72,9 @@ def announce_viewer(args: argparse.Namespace, srv: ServerThread) -> None:
         print("fsmscope: viewer (watch only) at %s" % srv.viewer_url, file=sys.stderr, flush=True)
 
 
+SWITCH_INTERVAL = 0.0005  # s a thread may hold the GIL while another waits for it (Python's default: 5 ms)
+
+
 def wait_for_interrupt() -> None:
     try:
         threading.Event().wait()

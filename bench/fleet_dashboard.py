@@ -7,13 +7,16 @@ overview open, and the dashboard page of one machine, whose events are timed), t
 Measured in the page: event-to-browser latency, from the event's ``t`` (the robot's clock, when the
 machine emitted it) to its arrival in the page (``Date.now()``, the same host's clock). Measured on
 the dashboard process: its CPU time (user + system, all threads, /proc) over the window, as a share
-of one core. Targets: p99 <= 20 ms; <= 25 % of one core. Medians of several windows.
+of one core. Targets: p99 <= 20 ms; <= 25 % of one core. Medians of several windows. Last, the
+same 20 streams read by websocket clients of this process with the browser closed: what the
+dashboard does when Chromium is not also on the machine's cores.
 
     .venv/bin/python bench/fleet_dashboard.py [--windows 3] [--seconds 10]
     .venv/bin/python bench/fleet_dashboard.py --robot r1 --connect tcp/127.0.0.1:PORT  (one robot: used by the bench)
 """
 
 import argparse
+import json
 import os
 import re
 import signal
@@ -156,6 +159,7 @@ def main() -> None:
             page.evaluate(PAGE_STREAMS, names[1:])
             heaviest = windows(page, dash.pid, args)
             browser.close()
+        without = [clients(found.group(1), names, dash.pid, args.seconds) for _ in range(args.windows)]
     finally:
         for proc in [*robots, dash]:  # SIGTERM: a SIGINT is ignored by a process started in the background
             proc.terminate()
@@ -163,7 +167,8 @@ def main() -> None:
             proc.wait(20)
     rows = []
     for view, measured, streams in (("fleet page + one machine's page", operator, 1),
-                                    ("all 20 machines streamed to a page", heaviest, len(names))):
+                                    ("all 20 machines streamed to a page", heaviest, len(names)),
+                                    ("all 20 streamed to Python clients, no browser", without, len(names))):
         median = lambda key: statistics.median(w[key] for w in measured)  # noqa: E731
         rows += [
             ("%s: events timed" % view, "%d/s" % (streams * RATE), "%.0f/s" % median("rate"), ""),
@@ -175,6 +180,39 @@ def main() -> None:
         ]
     print_table("One dashboard, %d machines in %d robot processes at %d events/s each (medians of %d windows of %g s)"
                 % (len(names), ROBOTS, RATE, args.windows, args.seconds), rows)
+
+
+def clients(fleet_url: str, names: list[str], pid: int, seconds: float) -> dict:
+    """One window of the 20 streams read by websocket clients in this process (no browser on the
+    machine's two cores): where the time goes when the browser is not there."""
+    from websockets.sync.client import connect
+
+    base, token = fleet_url.split("/fleet?token=")
+    latencies: list[float] = []
+    stop = time.time() + 2.0 + seconds
+
+    def follow(name: str) -> None:
+        url = "%s/api/machines/%s/stream?token=%s" % (base.replace("http", "ws", 1), name, token)
+        with connect(url, open_timeout=10) as ws:
+            while time.time() < stop:
+                frame = json.loads(ws.recv(timeout=5))
+                now = time.time()
+                if frame["type"] == "events":
+                    latencies.extend((now - event["t"]) * 1000 for event in frame["events"])
+
+    readers = [threading.Thread(target=follow, args=(name,)) for name in names]
+    for reader in readers:
+        reader.start()
+    time.sleep(2.0)  # the snapshots and the first events
+    del latencies[:]
+    cpu, start = cpu_seconds(pid), time.monotonic()
+    for reader in readers:
+        reader.join()
+    elapsed = time.monotonic() - start
+    share = (cpu_seconds(pid) - cpu) / elapsed
+    ordered = sorted(latencies)
+    at = lambda q: ordered[min(len(ordered) - 1, int(q * len(ordered)))]  # noqa: E731
+    return {"rate": len(ordered) / elapsed, "p50": at(0.5), "p99": at(0.99), "max": ordered[-1], "cpu": share}
 
 
 def windows(page, pid: int, args: argparse.Namespace) -> list[dict]:

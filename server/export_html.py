@@ -47,6 +47,7 @@ _IMPORT = re.compile(r"""(\b(?:from|import)\s*)(["'])(\.\.?/[^"']+)\2""")
 _STYLESHEET = re.compile(r'<link rel="stylesheet" href="([^"]+)">')
 _MODULE = re.compile(r'<script type="module" src="([^"]+)"></script>')
 _PRELOAD = re.compile(r'<link rel="modulepreload" href="[^"]+">\n')  # the export embeds every module
+_FLEET_LINK = re.compile(r'\s*<a class="fleet-link"[^>]*>[^<]*</a>')  # the server's fleet page: a file has none
 
 
 class ExportError(Exception):
@@ -204,6 +205,7 @@ def page(data: dict, title: str) -> str:
     styles.append(read(OFFLINE_STYLE))
     text = text.replace("</head>", "<style>%s</style>\n</head>" % styles[-1], 1)
     text = _PRELOAD.sub("", text)
+    text = _substitute(_FLEET_LINK, lambda m: "", text, "fleet link")
     module = _MODULE.search(text)
     if module is None:
         raise ExportError("static/index.html has no module script")

@@ -21,6 +21,7 @@ sys.path.insert(0, ROOT)
 import fsm  # noqa: E402
 from fleet.robot import ZenohRobot  # noqa: E402
 from runtime import two_state_loop  # noqa: E402
+from server.cli.fleet_bridge import robot_follows  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
@@ -45,9 +46,10 @@ def free_endpoint() -> str:
 def rate(srv: ServerThread, robot: ZenohRobot | None) -> float:
     """Transitions/s of one run of the loop, served by ``srv`` and published by ``robot`` (if any)."""
     sm, run = two_state_loop()
-    srv.hub.add_local(sm, name="loop-%d" % time.monotonic_ns())
-    if robot is not None:
+    entry = srv.hub.add_local(sm, name="loop-%d" % time.monotonic_ns())
+    if robot is not None:  # as `fsmscope run --zenoh` composes them (server/cli/fleet_bridge.py)
         fsm.attach(sm, robot)
+        robot_follows(robot, entry)
     start = time.perf_counter()
     count = run()
     elapsed = time.perf_counter() - start

@@ -4,8 +4,9 @@
     fsm.attach(sm, ZenohRobot("r1", connect=["tcp/192.168.1.10:7447"]), name="picker")
 
 The observer only appends to a bounded buffer (the machine's thread never waits for the network).
-A background thread applies the events to its own ``Status`` per machine, keeps the newest
-``RING`` of them, and puts them in batches on ``fsmscope/<robot>/<machine>/events``. Per machine
+A background thread applies the events to its own ``Status`` per machine (unless its host shares
+one it keeps anyway: ``share_status``), keeps the newest ``RING`` of them, and puts them in
+batches on ``fsmscope/<robot>/<machine>/events``. Per machine
 it also declares, on the machine's first event:
 
 - a liveliness token on ``fsmscope/<robot>/<machine>``: dashboards see the machine appear, and
@@ -26,7 +27,7 @@ from __future__ import annotations
 import collections
 import threading
 import time
-from typing import Any, Sequence
+from typing import Any, Callable, Sequence
 
 import zenoh
 
@@ -51,8 +52,11 @@ CONTROL_SETTLE = 1.0  # seconds a control's answer waits for the events it cause
 class _Machine:
     """What the robot keeps of one machine, and its Zenoh entities."""
 
-    def __init__(self, session: zenoh.Session, robot: str, name: str, controls: RobotControls) -> None:
+    def __init__(self, session: zenoh.Session, robot: str, name: str, controls: RobotControls,
+                 shared: dict[str, tuple[Any, Callable[[], Status]]]) -> None:
+        self.name = name
         self.status = Status(name)
+        self.shared = shared  # the robot's: a host's Status read instead of this one (ZenohRobot.share_status)
         self.ring: collections.deque[dict] = collections.deque(maxlen=RING)
         self.lock = threading.Lock()  # queries come from Zenoh's threads
         self.controls = controls
@@ -65,11 +69,12 @@ class _Machine:
         self.token = session.liveliness().declare_token(keys.machine_key(robot, name))  # last: all is there
 
     def _state(self, query: zenoh.Query) -> None:
-        with self.lock:
-            status = self.status
-            snapshot = schema.event(status.last_seq, time.time(), status.run, status.machine, "snapshot",
-                                    status.root_path or "/SM_ROOT", {"status": status.to_dict()})
-        query.reply(query.key_expr, dumps({"snapshot": snapshot, "controls": self.controls.offer(status.machine),
+        lock, current = self.shared.get(self.name) or (self.lock, lambda: self.status)
+        with lock:
+            status = current()
+            snapshot = schema.event(status.last_seq, time.time(), status.run, self.name, "snapshot",
+                                    status.root_path or "/SM_ROOT", {"status": dict(status.to_dict(), machine=self.name)})
+        query.reply(query.key_expr, dumps({"snapshot": snapshot, "controls": self.controls.offer(self.name),
                                            "origin": self.origin}))
 
     def _history(self, query: zenoh.Query) -> None:
@@ -107,6 +112,7 @@ class ZenohRobot:
         self.controls = RobotControls(token, lambda: self._handoff.drained(CONTROL_SETTLE))
         self._stop = threading.Event()
         self._machines: dict[str, _Machine] = {}
+        self._shared: dict[str, tuple[Any, Callable[[], Status]]] = {}
         self.sent = 0
         self._thread = threading.Thread(target=self._run, name="fsmscope-zenoh", daemon=True)
         self._thread.start()
@@ -124,6 +130,13 @@ class ZenohRobot:
         """Apply the controls of ``handle``'s machine through ``handle``: a host's own (one that runs the
         machine in its own loop, as the demo does) rather than one of the robot's."""
         self.controls.handles[handle.reporter.machine] = handle
+
+    def share_status(self, machine: str, lock: Any, current: Callable[[], Status]) -> None:
+        """Answer ``machine``'s state queries from a ``Status`` its host keeps anyway (``current()``,
+        read holding ``lock``): the dashboard's hub in the same process applies every event in the
+        machine's thread already. The robot's thread then only keeps and puts the events, which is
+        most of what publishing costs the machine (bench/fleet_cost.py)."""
+        self._shared[machine] = (lock, current)
 
     @property
     def dropped(self) -> int:
@@ -181,10 +194,11 @@ class ZenohRobot:
             machine = self._machines.get(name)
             if machine is None:
                 machine = self._machines[name] = _Machine(self.session, self.robot, keys.chunk(name, "machine"),
-                                                          self.controls)
+                                                          self.controls, self._shared)
             with machine.lock:
-                for event in events:
-                    machine.status.apply(event)
-                    machine.ring.append(event)
+                if name not in self._shared:
+                    for event in events:
+                        machine.status.apply(event)
+                machine.ring.extend(events)
             machine.publisher.put(dumps(events))
             self.sent += len(events)

@@ -152,3 +152,31 @@ def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quie
         robot.close()
         proxy.close()
         dash.watcher.close()
+
+
+def test_a_robot_sharing_its_hosts_status_answers_state_queries_from_it(quiet):
+    """As `fsmscope run --zenoh` composes it: the hub's Status (here one the test keeps) answers."""
+    endpoint = free_endpoint()
+    robot = ZenohRobot("r1", listen=[endpoint])
+    host = Status("loop")
+    lock = threading.Lock()
+
+    def keep(event: dict) -> None:
+        with lock:
+            host.apply(event)
+
+    try:
+        sm = slow_loop(10, 0.0)
+        fsm.attach(sm, keep, name="loop")
+        robot.share_status("loop", lock, lambda: host)
+        own = run_on(robot, sm)
+        assert robot._machines["loop"].status.last_seq == 0  # the robot kept no Status of its own
+        dash = Dashboard(connect=[endpoint])
+        try:
+            wait_for(lambda: dash.events, 10, what="a snapshot")
+            assert dash.events[0]["seq"] == own[-1]["seq"]
+            assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
+        finally:
+            dash.watcher.close()
+    finally:
+        robot.close()

@@ -17,7 +17,7 @@ import threading
 import time
 from typing import Any
 
-from .fleet_bridge import add_zenoh_arguments, zenoh_robot
+from .fleet_bridge import add_zenoh_arguments, robot_follows, zenoh_robot
 from .serving import add_server_arguments, announce_viewer, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"
@@ -86,17 +86,18 @@ def main(args: argparse.Namespace) -> int:
     server = None
     try:
         if args.headless:
-            handle = MachineHandle(machine, rep, False, holder=hold.set)  # no loop waits for a start: it ends
+            if robot is not None:  # no loop waits for a start: it ends
+                robot.take_controls(MachineHandle(machine, rep, False, holder=hold.set))
         else:
             scene = demo.scene
             server = start_server(args, scene_url=scene.url if scene is not None else None,
                                   show_pose=scene.show_pose if scene is not None else None)
-            handle = server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set,
-                                          holder=hold.set, recording=record_path).handle
+            entry = server.hub.add_local(machine, name=MACHINE_NAME, can_start=True, starter=resume.set,
+                                         holder=hold.set, recording=record_path)
+            if robot is not None:  # the dashboards on Zenoh take the same controls as this one
+                robot_follows(robot, entry)
             print("fsmscope demo: open %s" % server.url, flush=True)
             announce_viewer(args, server)
-        if robot is not None:  # the dashboards on Zenoh take the same controls as this one
-            robot.take_controls(handle)
         print("fsmscope demo: recording to %s" % record_path, flush=True)
     except BaseException:
         demo.close()

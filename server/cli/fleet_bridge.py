@@ -86,6 +86,13 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
     return robot
 
 
+def robot_follows(robot: ZenohRobot, entry: MachineEntry) -> None:
+    """A machine this process's dashboard serves too: the robot applies the dashboards' controls
+    through the hub's handle, and answers state queries from the hub's Status (kept anyway)."""
+    robot.take_controls(entry.handle)
+    robot.share_status(entry.name, entry.lock, lambda: entry.status)
+
+
 class FleetLink:
     """The link (server/remote_control.py) of one fleet machine's ``RemoteHandle``: its controls asked
     of its robot over Zenoh, with the dashboard's token for that robot."""

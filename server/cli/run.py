@@ -7,7 +7,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .fleet_bridge import add_zenoh_arguments, zenoh_robot
+from .fleet_bridge import add_zenoh_arguments, robot_follows, zenoh_robot
 from .serving import SWITCH_INTERVAL, add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
@@ -58,8 +58,8 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
 
     def serve(name: str, container: Any) -> None:
         entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path)
-        if robot is not None:  # one handle takes the controls from either side
-            robot.take_controls(entry.handle)
+        if robot is not None:  # one handle takes the controls from either side, one Status answers both
+            robot_follows(robot, entry)
 
     runner.on_machine.append(serve)
     runner.keep_open = True  # runs started from the dashboard after the script ends are recorded too

@@ -180,3 +180,18 @@ def test_a_robot_sharing_its_hosts_status_answers_state_queries_from_it(quiet):
             dash.watcher.close()
     finally:
         robot.close()
+
+
+def test_two_dashboards_watch_the_same_robot_and_each_gets_every_event(quiet):
+    first, second = free_endpoint(), free_endpoint()
+    dashes = [Dashboard(listen=[first]), Dashboard(listen=[second])]
+    robot = ZenohRobot("r1", connect=[first, second])
+    try:
+        own = run_on(robot, slow_loop(60))
+        for dash in dashes:
+            wait_for(lambda: dash.events and dash.events[-1]["seq"] == own[-1]["seq"], 10, what="the last event")
+            assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
+    finally:
+        robot.close()
+        for dash in dashes:
+            dash.watcher.close()

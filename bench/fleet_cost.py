@@ -9,7 +9,6 @@ transitions/s. Medians of 5 runs.
 
 import argparse
 import os
-import socket
 import statistics
 import subprocess
 import sys
@@ -23,6 +22,7 @@ from fleet.robot import ZenohRobot  # noqa: E402
 from runtime import two_state_loop  # noqa: E402
 from server.cli.fleet_bridge import robot_follows  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
+from server.testing.demo_process import free_endpoint  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 WATCHER = """
@@ -35,12 +35,6 @@ FleetWatcher(count, lambda name, up: None, listen=[sys.argv[1]])
 print("listening", flush=True)
 threading.Event().wait()
 """
-
-
-def free_endpoint() -> str:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return "tcp/127.0.0.1:%d" % s.getsockname()[1]
 
 
 def rate(srv: ServerThread, robot: ZenohRobot | None) -> float:

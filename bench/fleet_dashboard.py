@@ -20,7 +20,6 @@ import json
 import os
 import re
 import signal
-import socket
 import statistics
 import subprocess
 import sys
@@ -30,6 +29,7 @@ import time
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 sys.path.insert(0, ROOT)
 
+from server.testing.demo_process import free_endpoint  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 ROBOTS = 5
@@ -67,12 +67,6 @@ PAGE_WINDOW = """
   return { rate: all.length / seconds, p50: at(0.5), p99: at(0.99), max: all[all.length - 1] };
 }
 """
-
-
-def free_endpoint() -> str:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return "tcp/127.0.0.1:%d" % s.getsockname()[1]
 
 
 def robot(name: str, connect: str) -> None:

@@ -19,17 +19,11 @@ import fsm
 import httpx
 
 from fsm.logfiles.log_reader import read_events
+from server.testing.demo_process import free_endpoint
 from server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
 PATROL = Path(__file__).resolve().parent / "robots" / "patrol.py"
-
-
-def free_endpoint() -> str:
-    """``tcp/127.0.0.1:PORT`` of a port free now."""
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return "tcp/127.0.0.1:%d" % s.getsockname()[1]
 
 
 class Tick(fsm.State):

@@ -9,7 +9,6 @@ from __future__ import annotations
 import pytest
 from fleet_support import Dashboard, Robot
 
-from server.testing.polling import wait_for
 
 TOKEN = "fleet-token"
 LIVELINESS_S = 10  # a killed robot's link is dropped after fleet.config.LEASE_MS (3 s): well within this

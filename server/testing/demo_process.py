@@ -23,6 +23,11 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def free_endpoint() -> str:
+    """A Zenoh endpoint, ``tcp/127.0.0.1:PORT``, on a port free right now (the fleet's tests and benches)."""
+    return "tcp/127.0.0.1:%d" % free_port()
+
+
 class DemoProcess:
     """``fsmscope demo`` in its own process group; ``url`` is the dashboard address it printed."""
 

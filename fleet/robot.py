@@ -3,23 +3,27 @@
     from fleet.robot import ZenohRobot
     fsm.attach(sm, ZenohRobot("r1", connect=["tcp/192.168.1.10:7447"]), name="picker")
 
-The observer only appends to a bounded buffer (the machine's thread never waits for the network).
-A background thread applies the events to its own ``Status`` per machine (unless its host shares
-one it keeps anyway: ``share_status``), keeps the newest ``RING`` of them, and puts them in
-batches on ``fsmscope/<robot>/<machine>/events``. Per machine
-it also declares, on the machine's first event:
+The observer batches each machine's events in the machine's own thread (their bytes encoded once
+for every observer: ``fsm.observation.encoding.encoded``) and puts a batch on
+``fsmscope/<robot>/<machine>/events`` when it holds ``MAX_BATCH`` events or its first is ``LINGER``
+old; a flusher thread puts the batches the machine left (it went quiet). Puts drop rather than wait
+when the network is congested (Zenoh's ``CongestionControl.DROP``), so the machine never waits for
+the network; and no other thread touches each event (a hand-off to a sender thread cost the
+two-state loop about three times as much: the GIL and the cache lines moved between the threads,
+bench/fleet_cost.py). Per machine it also declares, on the machine's first event:
 
 - a liveliness token on ``fsmscope/<robot>/<machine>``: dashboards see the machine appear, and
   see it gone within Zenoh's lease when the process dies or drops off the network;
 - a queryable ``.../state``: the machine's snapshot event (its whole state now), for a dashboard
   that joins late, and what controls it takes;
-- a queryable ``.../history?since=SEQ``: the events from SEQ on that the ring still holds (a
-  dashboard whose connection dropped fills its gap; older than the ring: it takes the snapshot);
+- a queryable ``.../history?since=SEQ``: the batches put that hold the events from SEQ on, of the
+  newest ``RING`` events (a dashboard whose connection dropped fills its gap; older than that: it
+  takes the snapshot);
 - a queryable ``.../control``: a dashboard's control, carrying the robot's token, applied to the
   machine and answered (fleet/control.py).
 
 When nobody listens or the network is gone, puts go nowhere and the machine runs on; memory stays
-bounded by the buffer and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
+bounded by the batches and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
 """
 
 from __future__ import annotations
@@ -27,38 +31,45 @@ from __future__ import annotations
 import collections
 import threading
 import time
+from time import monotonic
 from typing import Any, Callable, Sequence
 
 import zenoh
 
 from fsm.control.handle import MachineHandle
 from fsm.observation import closing, introspection, schema
-from fsm.observation.encoding import dumps
-from fsm.observation.handoff import Handoff
+from fsm.observation.encoding import dumps, encoded
 from fsm.observation.status import Status
 
 from . import keys
 from .config import session_config
 from .control import RobotControls
 
-BUFFER = 100_000  # events waiting for the sender before the oldest are dropped
-RING = 10_000  # events of each machine kept for history queries
-MAX_BATCH = 2000  # events per put
-LINGER = 0.005  # seconds the sender lets events gather after the first (fewer, larger puts: a dashboard
+RING = 10_000  # events of each machine kept (as the batches put) for history queries
+MAX_BATCH = 512  # events per put at most (a payload of about 100 kB: larger ones cost more per byte to
+                 # allocate, as fresh pages)
+LINGER = 0.005  # seconds a batch gathers events after its first (fewer, larger puts: a dashboard
                 # following a fleet pays per put received, not per event)
-CONTROL_SETTLE = 1.0  # seconds a control's answer waits for the events it caused to be put
 
 
 class _Machine:
-    """What the robot keeps of one machine, and its Zenoh entities."""
+    """What the robot keeps of one machine: its pending batch, the batches put, its Zenoh entities."""
 
     def __init__(self, session: zenoh.Session, robot: str, name: str, controls: RobotControls,
-                 shared: dict[str, tuple[Any, Callable[[], Status]]]) -> None:
+                 shared: dict[str, tuple[Any, Callable[[], Status]]], wake: threading.Event) -> None:
         self.name = name
         self.status = Status(name)
-        self.shared = shared  # the robot's: a host's Status read instead of this one (ZenohRobot.share_status)
-        self.ring: collections.deque[dict] = collections.deque(maxlen=RING)
-        self.lock = threading.Lock()  # queries come from Zenoh's threads
+        self.shared = shared  # the robot's: a host's Status read instead of this one (ZenohRobot.follow)
+        self.wake = wake  # the flusher's
+        self.lock = threading.Lock()  # guards the Status (the machine's thread and Zenoh's queries)
+        # The batch gathering, (seq, encoded event): the machine's thread appends without a lock (a
+        # deque's append and popleft are atomic), whoever puts takes it holding ``putting``.
+        self.pending: collections.deque[tuple[int, bytes]] = collections.deque()
+        self.since = 0.0  # when the batch's first event came (monotonic)
+        self.putting = threading.Lock()  # one put at a time: batches go in order; guards the ring
+        self.ring: collections.deque[tuple[int, int, int, bytes]] = collections.deque()  # (first, last, count, payload)
+        self.kept = 0  # events in the ring
+        self.closed = False
         self.controls = controls
         self.origin = str(session.zid())  # a new process is a new session: its seqs start again
         self.publisher = session.declare_publisher(keys.events_key(robot, name),
@@ -67,6 +78,45 @@ class _Machine:
         self.history = session.declare_queryable(keys.history_key(robot, name), self._history)
         self.control = controls.declare(session, keys.control_key(robot, name), name)
         self.token = session.liveliness().declare_token(keys.machine_key(robot, name))  # last: all is there
+
+    def keep(self, event: dict) -> None:
+        """In the machine's thread, as its observer: keep the machine's Status, then take the event."""
+        with self.lock:
+            self.status.apply(event)
+        self.take((event["seq"], encoded(event)))
+
+    def take(self, item: tuple[int, bytes]) -> None:
+        """In the machine's thread: an event, (seq, its JSON), joins the pending batch, put when full
+        or ``LINGER`` old (looked at every 16 events: a busy machine puts its own batches, the flusher
+        those of a quiet one). The fewest steps: this is what publishing costs each step of a
+        machine whose host encodes its events anyway (ZenohRobot.follow)."""
+        pending = self.pending
+        pending.append(item)
+        n = len(pending)
+        if n == 1:
+            self.since = monotonic()
+            self.wake.set()
+        elif not n & 15 and (n >= MAX_BATCH or monotonic() - self.since >= LINGER):
+            self.flush()
+
+    def flush(self, now: float | None = None) -> float | None:
+        """Put the pending batch if it is due at ``now`` (None: whatever its age). Returns when the
+        batch still pending is due, None when none is."""
+        with self.putting:
+            pending = self.pending
+            if not pending or self.closed:
+                return None
+            if now is not None and now - self.since < LINGER:
+                return self.since + LINGER
+            items = [pending.popleft() for _ in range(len(pending))]
+            payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
+            self.publisher.put(payload)
+            ring = self.ring
+            ring.append((items[0][0], items[-1][0], len(items), payload))
+            self.kept += len(items)
+            while self.kept - ring[0][2] >= RING:  # the oldest batches past RING events let go
+                self.kept -= ring.popleft()[2]
+            return None
 
     def _state(self, query: zenoh.Query) -> None:
         lock, current = self.shared.get(self.name) or (self.lock, lambda: self.status)
@@ -83,13 +133,16 @@ class _Machine:
         except ValueError:
             query.reply_err(b"since must be an integer")
             return
-        with self.lock:
-            kept = list(self.ring)
-        first = kept[0]["seq"] if kept else None
-        events = [e for e in kept if e["seq"] >= since]
-        query.reply(query.key_expr, dumps({"complete": first is not None and first <= since, "events": events}))
+        with self.putting:
+            complete = bool(self.ring) and self.ring[0][0] <= since
+            payloads = [payload[1:-1] for first, last, count, payload in self.ring if last >= since]
+        # The batches holding the events from ``since`` on: the dashboard drops those before it had.
+        query.reply(query.key_expr, b'{"complete":%s,"events":[%s]}' % (b"true" if complete else b"false",
+                                                                       b",".join(payloads)))
 
     def close(self) -> None:
+        with self.putting:
+            self.closed = True
         for entity in (self.token, self.control, self.history, self.state, self.publisher):
             entity.undeclare()
 
@@ -102,25 +155,43 @@ class ZenohRobot:
     machine again (in a new thread)."""
 
     def __init__(self, robot: str, connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
-                 scouting: bool = False, buffer: int = BUFFER, token: str | None = None,
-                 can_start: bool = False) -> None:
+                 scouting: bool = False, token: str | None = None, can_start: bool = False) -> None:
         self.robot = keys.chunk(robot, "robot")
         self.can_start = can_start
         self.session = zenoh.open(session_config(connect, listen, mode, scouting))
-        self._handoff = Handoff(buffer)
-        self._buf = self._handoff.events
-        self.controls = RobotControls(token, lambda: self._handoff.drained(CONTROL_SETTLE))
+        self.controls = RobotControls(token, self.flush)
         self._stop = threading.Event()
+        self._wake = threading.Event()  # a batch began: the flusher puts it if its machine goes quiet
         self._machines: dict[str, _Machine] = {}
+        self._declaring = threading.Lock()
         self._shared: dict[str, tuple[Any, Callable[[], Status]]] = {}
-        self.sent = 0
         self._thread = threading.Thread(target=self._run, name="fsmscope-zenoh", daemon=True)
         self._thread.start()
         closing.close_at_exit(self)
 
     # The observer: runs in the machine's thread.
     def __call__(self, event: dict) -> None:
-        self._handoff(event)
+        try:
+            machine = self._machines[event["machine"]]
+        except KeyError:
+            machine = self._declare(event["machine"])
+        machine.keep(event)
+
+    def _declare(self, name: str) -> _Machine:
+        """A machine's first event: its Zenoh entities (machines of other threads may come at once)."""
+        with self._declaring:
+            if name not in self._machines:
+                key = keys.chunk(name, "machine")  # a name Zenoh cannot take fails here, in the machine's thread
+                made = threading.Thread(target=self._declare_in_thread, args=(name, key), daemon=True)
+                made.start()
+                made.join()
+            return self._machines[name]
+
+    def _declare_in_thread(self, name: str, key: str) -> None:
+        """In a daemon thread: Zenoh runs a queryable's callbacks in a Python thread that is a daemon
+        only when the declaring thread is one, and a thread that is not would keep the process from
+        ending (Python waits for those before the exit hook that closes the robot)."""
+        self._machines[name] = _Machine(self.session, self.robot, key, self.controls, self._shared, self._wake)
 
     def attached(self, reporter: introspection.Reporter) -> None:
         """``fsm.attach`` gave this robot a machine: it takes the dashboards' controls from now on."""
@@ -131,32 +202,33 @@ class ZenohRobot:
         machine in its own loop, as the demo does) rather than one of the robot's."""
         self.controls.handles[handle.reporter.machine] = handle
 
-    def share_status(self, machine: str, lock: Any, current: Callable[[], Status]) -> None:
-        """Answer ``machine``'s state queries from a ``Status`` its host keeps anyway (``current()``,
-        read holding ``lock``): the dashboard's hub in the same process applies every event in the
-        machine's thread already. The robot's thread then only keeps and puts the events, which is
-        most of what publishing costs the machine (bench/fleet_cost.py)."""
+    def follow(self, machine: str, handle: MachineHandle, lock: Any,
+               current: Callable[[], Status]) -> Callable[[tuple[int, bytes]], None]:
+        """Publish a machine its host observes anyway (the dashboard's hub, as ``run --zenoh`` and
+        ``demo --zenoh`` compose them), instead of observing it too: the host gives the returned
+        callable each event as (seq, its JSON), in the machine's thread; controls are applied through
+        the host's ``handle``; state queries are answered from the host's ``Status`` (``current()``,
+        read holding ``lock``). The robot then keeps no Status and encodes nothing: publishing costs
+        the machine one call per event (bench/fleet_cost.py)."""
+        self.take_controls(handle)
         self._shared[machine] = (lock, current)
+        return self._declare(machine).take
 
-    @property
-    def dropped(self) -> int:
-        """Events dropped because the buffer was full."""
-        return self._handoff.dropped
-
-    def flush(self, timeout: float = 5.0) -> bool:
-        """Wait until every buffered event was put; False on timeout."""
-        return self._handoff.drained(timeout)
+    def flush(self) -> None:
+        """Put every pending batch now (a control's answer comes after the events it caused)."""
+        for machine in list(self._machines.values()):
+            machine.flush()
 
     def close(self, timeout: float = 5.0) -> None:
-        """Put what is buffered, then leave the network (the machines' tokens go: dashboards see them
+        """Put what is pending, then leave the network (the machines' tokens go: dashboards see them
         gone). Idempotent."""
         if self._stop.is_set():
             return
-        self.flush(timeout)
         self._stop.set()
-        self._handoff.wake.set()
+        self._wake.set()
         if self._thread is not threading.current_thread():
             self._thread.join(timeout)
+        self.flush()
         self.controls.close(timeout)
         for machine in self._machines.values():
             machine.close()
@@ -170,35 +242,16 @@ class ZenohRobot:
         self.close()
 
     def _run(self) -> None:
-        wake = self._handoff.wake
+        """The flusher: puts the batches of machines that went quiet, once they are ``LINGER`` old."""
         while not self._stop.is_set():
-            if wake.wait(0.5):
-                self._stop.wait(LINGER)  # the events of the next few ms go with this one's
-            wake.clear()
-            while self._buf:
-                self._handoff.busy = True
-                self._send(self._take())
-            self._handoff.busy = False
+            self._wake.wait(0.5)
+            self._wake.clear()
+            due = self._flush_due()
+            while due is not None and not self._stop.wait(max(0.0, due - monotonic())):
+                due = self._flush_due()
 
-    def _take(self) -> dict[str, list[dict]]:
-        batches: dict[str, list[dict]] = {}
-        taken = 0
-        while self._buf and taken < MAX_BATCH:
-            event = self._buf.popleft()
-            batches.setdefault(event["machine"], []).append(event)
-            taken += 1
-        return batches
-
-    def _send(self, batches: dict[str, list[dict]]) -> None:
-        for name, events in batches.items():
-            machine = self._machines.get(name)
-            if machine is None:
-                machine = self._machines[name] = _Machine(self.session, self.robot, keys.chunk(name, "machine"),
-                                                          self.controls, self._shared)
-            with machine.lock:
-                if name not in self._shared:
-                    for event in events:
-                        machine.status.apply(event)
-                machine.ring.extend(events)
-            machine.publisher.put(dumps(events))
-            self.sent += len(events)
+    def _flush_due(self) -> float | None:
+        """Put the batches due now; when the earliest of those still pending is due."""
+        now = monotonic()
+        dues = [due for due in (machine.flush(now) for machine in list(self._machines.values())) if due is not None]
+        return min(dues, default=None)

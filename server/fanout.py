@@ -32,7 +32,7 @@ import threading
 import time
 from typing import Any, Callable
 
-from fsm.observation.encoding import dumps
+from fsm.observation.encoding import dumps, encoded
 from fsm.observation.status import Status
 
 from .history import status_answer
@@ -71,12 +71,18 @@ class Feed:
         self.idle: set[Client] = set()  # clients whose sender waits for the next event
         self._snapshot: tuple[int, int, str] | None = None  # (id(status), last_seq, frame)
         self.timeline = TimelineIndex()
+        # Another consumer of the encoded events, given each (seq, JSON) in the machine's thread: a
+        # Zenoh robot publishing the machine (fleet.robot.ZenohRobot.follow, composed by the CLI).
+        self.tap: Callable[[tuple[int, bytes]], None] | None = None
 
     # In the machine's thread.
     def observe(self, event: dict) -> bool:
-        """Apply, encode, hand over; True when the loop must be told."""
-        encoded = dumps(event)
+        """Apply, encode (once for every observer: fsm.observation.encoding.encoded), hand over; True
+        when the loop must be told."""
+        item = (event["seq"], encoded(event))
         self.timeline.add(event)
+        if self.tap is not None:
+            self.tap(item)
         with self.lock:
             if event["seq"] >= self.next_keyframe:
                 self.keyframe()
@@ -85,7 +91,7 @@ class Feed:
             if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
                 self.dropped += len(handoff)
                 handoff.clear()
-            handoff.append((event["seq"], encoded))
+            handoff.append(item)
             if self.queued:
                 return False
             self.queued = True
@@ -172,7 +178,7 @@ class Feed:
             start = self.status.run_seq
         ring = self.ring
         first = ring[0][0] if ring else upto + 1
-        events = [encoded for seq, encoded in ring if start <= seq <= upto]
+        events = [data for seq, data in ring if start <= seq <= upto]
         complete = first <= start and len(events) <= HISTORY
         return (b'{"complete":%s,"events":[%s]}'
                 % (b"true" if complete else b"false", b",".join(events[-HISTORY:]))).decode()

@@ -7,7 +7,7 @@ import math
 
 import fsm
 import numpy as np
-from fsm.observation.encoding import DEFAULT_CAP, encode, encode_userdata
+from fsm.observation.encoding import DEFAULT_CAP, dumps, encode, encode_userdata, encoded
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -109,3 +109,17 @@ json_like = st.recursive(
 @given(json_like)
 def test_any_nested_value_encodes_to_strict_json(value):
     strict_json(encode(value))
+
+
+def test_the_observers_of_one_event_share_one_encoding_of_it():
+    event = {"seq": 1, "kind": "transition"}
+    first = encoded(event)
+    assert first == dumps(event)
+    assert encoded(event) is first
+
+
+def test_another_event_is_encoded_for_itself_even_when_equal():
+    event = {"seq": 1, "kind": "transition"}
+    first = encoded(event)
+    copy = dict(event)
+    assert encoded(copy) is not first and encoded(copy) == first

@@ -14,6 +14,8 @@ from fleet_support import Proxy, free_endpoint, slow_loop
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
+from fsm.control.handle import MachineHandle
+from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 from server.testing.polling import wait_for
 
@@ -154,27 +156,31 @@ def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quie
         dash.watcher.close()
 
 
-def test_a_robot_sharing_its_hosts_status_answers_state_queries_from_it(quiet):
-    """As `fsmscope run --zenoh` composes it: the hub's Status (here one the test keeps) answers."""
+def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answers_from_its_status(quiet):
+    """As `fsmscope run --zenoh` composes it (the hub is the host): the robot observes nothing itself."""
     endpoint = free_endpoint()
     robot = ZenohRobot("r1", listen=[endpoint])
     host = Status("loop")
     lock = threading.Lock()
-
-    def keep(event: dict) -> None:
-        with lock:
-            host.apply(event)
-
+    own: list[dict] = []
     try:
         sm = slow_loop(10, 0.0)
-        fsm.attach(sm, keep, name="loop")
-        robot.share_status("loop", lock, lambda: host)
-        own = run_on(robot, sm)
-        assert robot._machines["loop"].status.last_seq == 0  # the robot kept no Status of its own
+        reporter = fsm.attach(sm, own.append, name="loop")
+        take = robot.follow("loop", MachineHandle(sm, reporter, can_start=False), lock, lambda: host)
+
+        def host_observer(event: dict) -> None:
+            with lock:
+                host.apply(event)
+            take((event["seq"], dumps(event)))
+
+        reporter.add_observer(host_observer)
         dash = Dashboard(connect=[endpoint])
         try:
-            wait_for(lambda: dash.events, 10, what="a snapshot")
-            assert dash.events[0]["seq"] == own[-1]["seq"]
+            wait_for(lambda: ("r1:loop", True) in dash.alive and dash.events, 10, what="the machine's snapshot")
+            sm.execute()
+            robot.flush()
+            wait_for(lambda: dash.events[-1]["seq"] == own[-1]["seq"], 10, what="the last event")
+            assert robot._machines["loop"].status.last_seq == 0  # the robot kept no Status of its own
             assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
         finally:
             dash.watcher.close()

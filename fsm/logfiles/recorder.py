@@ -84,14 +84,16 @@ class Recorder:
         self._writer.start()
         closing.close_at_exit(self)
 
-    # The observer call: keep it cheap (an encode, an append and one step of the reducer).
+    # The observer call: keep it cheap (an encode, shared with the other observers, an append and
+    # one step of the reducer).
     def __call__(self, event: dict) -> None:
-        line = _dumps_line(event)
+        data = encoding.encoded(event)
         with self._lock:
             if self._closed:
                 return
             buf = self._buf
-            buf += line
+            buf += data
+            buf += b"\n"
             status = self._statuses.get(event["machine"])
             if status is None:
                 status = self._new_machine(event["machine"], event["seq"])

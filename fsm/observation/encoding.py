@@ -82,3 +82,22 @@ else:
         return json.dumps(obj, separators=(",", ":"), ensure_ascii=False).encode()
 
     loads = json.loads
+
+
+_last_encoded: tuple[Any, bytes] = (None, b"")
+
+
+def encoded(event: dict) -> bytes:
+    """``dumps(event)``, done once for all the observers of an event that keep or send it as bytes
+    (the dashboard's hub, the recorder, a Zenoh robot): a reporter hands the same dict to its
+    observers one after another, and the second finds the first's bytes here. One slot for the
+    process, matched by identity and holding the dict (so its id is never reused meanwhile): a
+    machine in another thread may take the slot in between, and then the bytes are made again,
+    never wrong. Observers do not change the events they are given."""
+    global _last_encoded
+    last = _last_encoded
+    if last[0] is event:
+        return last[1]
+    data = dumps(event)
+    _last_encoded = (event, data)
+    return data

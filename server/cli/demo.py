@@ -71,8 +71,6 @@ def main(args: argparse.Namespace) -> int:
     recorder = Recorder(record_path)
     rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
     robot = zenoh_robot(args, can_start=False)
-    if robot is not None:
-        fsm.attach(machine, robot, name=MACHINE_NAME)
 
     def record_pose(fields: dict) -> bool:
         if rep.run is None:  # not started yet: a log opens with the machine's structure
@@ -87,6 +85,7 @@ def main(args: argparse.Namespace) -> int:
     try:
         if args.headless:
             if robot is not None:  # no loop waits for a start: it ends
+                fsm.attach(machine, robot, name=MACHINE_NAME)
                 robot.take_controls(MachineHandle(machine, rep, False, holder=hold.set))
         else:
             scene = demo.scene

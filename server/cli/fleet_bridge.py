@@ -87,10 +87,10 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
 
 
 def robot_follows(robot: ZenohRobot, entry: MachineEntry) -> None:
-    """A machine this process's dashboard serves too: the robot applies the dashboards' controls
-    through the hub's handle, and answers state queries from the hub's Status (kept anyway)."""
-    robot.take_controls(entry.handle)
-    robot.share_status(entry.name, entry.lock, lambda: entry.status)
+    """A machine this process's dashboard serves too: the robot publishes the events the hub encodes
+    anyway (rather than observing the machine itself), applies the dashboards' controls through the
+    hub's handle, and answers state queries from the hub's Status."""
+    entry.tap = robot.follow(entry.name, entry.handle, entry.lock, lambda: entry.status)
 
 
 class FleetLink:

@@ -39,9 +39,9 @@ def main(args: argparse.Namespace) -> int:
 
     runner = Runner(args.script, list(args.extra), args.record)
     robot = zenoh_robot(args, can_start=True)
-    if robot is not None:
-        runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
     if args.no_serve:
+        if robot is not None:
+            runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
         return runner.run()
     return run_with_dashboard(args, runner, robot)
 
@@ -58,7 +58,7 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
 
     def serve(name: str, container: Any) -> None:
         entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path)
-        if robot is not None:  # one handle takes the controls from either side, one Status answers both
+        if robot is not None:  # publishes what the hub encodes; one handle and one Status serve both sides
             robot_follows(robot, entry)
 
     runner.on_machine.append(serve)

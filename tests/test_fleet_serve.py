@@ -5,6 +5,7 @@ and takes the dashboard's controls when it holds the robot's token."""
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 import threading
@@ -175,3 +176,21 @@ def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_p
     last = published(["run", str(script), "--no-serve", "--zenoh", "arm2"], tmp_path / "pick.jsonl", endpoint)
     wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
     assert {e["machine"] for e in seen} == {"arm2:pick"}
+
+
+def test_a_script_run_and_served_with_zenoh_publishes_the_events_its_dashboard_encodes(tmp_path, watching):
+    endpoint, seen = watching
+    script = tmp_path / "pick.py"
+    script.write_text(SCRIPT)
+    last = published(["run", str(script), "--exit", "--zenoh", "arm3"], tmp_path / "pick.jsonl", endpoint)
+    wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
+    assert {e["machine"] for e in seen} == {"arm3:pick"}
+
+
+def test_a_script_that_never_closes_its_robot_still_exits(tmp_path):
+    script = tmp_path / "forgetful.py"
+    script.write_text(SCRIPT.replace("import fsm\n", "import fsm\nfrom fleet.robot import ZenohRobot\n")
+                      .replace("sm.execute()", "fsm.attach(sm, ZenohRobot('r1'), name='pick')\nsm.execute()"))
+    done = subprocess.run([sys.executable, str(script)], cwd=ROOT, capture_output=True, text=True, timeout=30,
+                          env={**os.environ, "PYTHONPATH": str(ROOT)})
+    assert done.returncode == 0, done.stderr

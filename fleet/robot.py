@@ -4,9 +4,11 @@
     fsm.attach(sm, ZenohRobot("r1", connect=["tcp/192.168.1.10:7447"]), name="picker")
 
 The observer batches each machine's events in the machine's own thread (their bytes encoded once
-for every observer: ``fsm.observation.encoding.encoded``) and puts a batch on
-``fsmscope/<robot>/<machine>/events`` when it holds ``MAX_BATCH`` events or its first is ``LINGER``
-old; a flusher thread puts the batches the machine left (it went quiet). Puts drop rather than wait
+for every observer: ``fsm.observation.encoding.encoded``) and puts them on
+``fsmscope/<robot>/<machine>/events``: an event at once when the machine's last put is ``LINGER``
+old (a machine of a few events a second adds no delay), else with the others that come until then
+(a busy machine puts at most once per ``LINGER``, or per ``MAX_BATCH`` events); a flusher thread
+puts the batches the machine left when it went quiet. Puts drop rather than wait
 when the network is congested (Zenoh's ``CongestionControl.DROP``), so the machine never waits for
 the network; and no other thread touches each event (a hand-off to a sender thread cost the
 two-state loop about three times as much: the GIL and the cache lines moved between the threads,
@@ -48,8 +50,8 @@ from .control import RobotControls
 RING = 10_000  # events of each machine kept (as the batches put) for history queries
 MAX_BATCH = 512  # events per put at most (a payload of about 100 kB: larger ones cost more per byte to
                  # allocate, as fresh pages)
-LINGER = 0.005  # seconds a batch gathers events after its first (fewer, larger puts: a dashboard
-                # following a fleet pays per put received, not per event)
+LINGER = 0.005  # seconds between a machine's puts at least (fewer, larger puts: a dashboard following
+                # a fleet pays per put received, not per event)
 
 
 class _Machine:
@@ -65,7 +67,8 @@ class _Machine:
         # The batch gathering, (seq, encoded event): the machine's thread appends without a lock (a
         # deque's append and popleft are atomic), whoever puts takes it holding ``putting``.
         self.pending: collections.deque[tuple[int, bytes]] = collections.deque()
-        self.since = 0.0  # when the batch's first event came (monotonic)
+        self.last_put = -LINGER  # when the last batch was put (monotonic)
+        self.due = 0.0  # when the pending batch is put at the latest
         self.putting = threading.Lock()  # one put at a time: batches go in order; guards the ring
         self.ring: collections.deque[tuple[int, int, int, bytes]] = collections.deque()  # (first, last, count, payload)
         self.kept = 0  # events in the ring
@@ -86,17 +89,21 @@ class _Machine:
         self.take((event["seq"], encoded(event)))
 
     def take(self, item: tuple[int, bytes]) -> None:
-        """In the machine's thread: an event, (seq, its JSON), joins the pending batch, put when full
-        or ``LINGER`` old (looked at every 16 events: a busy machine puts its own batches, the flusher
-        those of a quiet one). The fewest steps: this is what publishing costs each step of a
-        machine whose host encodes its events anyway (ZenohRobot.follow)."""
+        """In the machine's thread: an event, (seq, its JSON), is put at once if the last put is
+        ``LINGER`` old, else joins the pending batch, put when due or full (looked at every 16
+        events: a busy machine puts its own batches, the flusher those of a machine that went quiet).
+        The fewest steps: this is what publishing costs each step of a machine whose host encodes
+        its events anyway (ZenohRobot.follow)."""
         pending = self.pending
         pending.append(item)
         n = len(pending)
         if n == 1:
-            self.since = monotonic()
-            self.wake.set()
-        elif not n & 15 and (n >= MAX_BATCH or monotonic() - self.since >= LINGER):
+            self.due = self.last_put + LINGER
+            if monotonic() >= self.due:
+                self.flush()
+            else:
+                self.wake.set()
+        elif not n & 15 and (n >= MAX_BATCH or monotonic() >= self.due):
             self.flush()
 
     def flush(self, now: float | None = None) -> float | None:
@@ -106,11 +113,12 @@ class _Machine:
             pending = self.pending
             if not pending or self.closed:
                 return None
-            if now is not None and now - self.since < LINGER:
-                return self.since + LINGER
+            if now is not None and now < self.due:
+                return self.due
             items = [pending.popleft() for _ in range(len(pending))]
             payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
             self.publisher.put(payload)
+            self.last_put = monotonic()
             ring = self.ring
             ring.append((items[0][0], items[-1][0], len(items), payload))
             self.kept += len(items)
@@ -242,7 +250,7 @@ class ZenohRobot:
         self.close()
 
     def _run(self) -> None:
-        """The flusher: puts the batches of machines that went quiet, once they are ``LINGER`` old."""
+        """The flusher: puts the batches of machines that went quiet, when they are due."""
         while not self._stop.is_set():
             self._wake.wait(0.5)
             self._wake.clear()

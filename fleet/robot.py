@@ -172,6 +172,7 @@ class ZenohRobot:
         self._wake = threading.Event()  # a batch began: the flusher puts it if its machine goes quiet
         self._machines: dict[str, _Machine] = {}
         self._declaring = threading.Lock()
+        self._callback_threads: list[threading.Thread] = []  # Zenoh's, running our queryables' callbacks
         self._shared: dict[str, tuple[Any, Callable[[], Status]]] = {}
         self._thread = threading.Thread(target=self._run, name="fsmscope-zenoh", daemon=True)
         self._thread.start()
@@ -198,8 +199,12 @@ class ZenohRobot:
     def _declare_in_thread(self, name: str, key: str) -> None:
         """In a daemon thread: Zenoh runs a queryable's callbacks in a Python thread that is a daemon
         only when the declaring thread is one, and a thread that is not would keep the process from
-        ending (Python waits for those before the exit hook that closes the robot)."""
+        ending (Python waits for those before the exit hook that closes the robot). ``close`` waits
+        for those threads to end: one still in Zenoh's code when the interpreter ends aborts it."""
+        before = set(threading.enumerate())
         self._machines[name] = _Machine(self.session, self.robot, key, self.controls, self._shared, self._wake)
+        self._callback_threads += [thread for thread in threading.enumerate()
+                                   if thread not in before and thread is not threading.current_thread()]
 
     def attached(self, reporter: introspection.Reporter) -> None:
         """``fsm.attach`` gave this robot a machine: it takes the dashboards' controls from now on."""
@@ -241,6 +246,8 @@ class ZenohRobot:
         for machine in self._machines.values():
             machine.close()
         self.session.close()
+        for thread in self._callback_threads:
+            thread.join(timeout)
         closing.closed(self)
 
     def __enter__(self) -> ZenohRobot:

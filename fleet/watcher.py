@@ -3,8 +3,9 @@ gap, whenever the dashboard joins and however often the network drops.
 
 A machine is found by its liveliness token (``fsmscope/<robot>/<machine>``, with Zenoh's history:
 those alive before the dashboard came too). On finding one the watcher asks its ``.../state``
-(a snapshot event) and delivers it; then it delivers the machine's events from ``.../events`` in
-seq order. An event beyond the next one expected (batches were lost while the network was down)
+and its ``.../history`` from the first event: when the robot still keeps every event of the machine
+it delivers them all (a dashboard that joins late, or restarted, sees the whole run), else the
+state's snapshot; then it delivers the machine's events from ``.../events`` in seq order. An event beyond the next one expected (batches were lost while the network was down)
 makes it ask ``.../history?since=`` for the missing ones first; when the robot no longer keeps
 them, it takes a new snapshot instead. A token withdrawn (the robot's process ended, or dropped off
 the network past Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine:
@@ -62,6 +63,7 @@ class FleetWatcher:
         self._lock = threading.Lock()  # one sample handled at a time, by either reader
         self.gaps_filled = 0
         self.snapshots = 0
+        self.backfilled = 0  # machines taken from their first event
         self.id = str(self.session.zid())
         self._presence = self.session.liveliness().declare_token(keys.dashboard_key(self.id))
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
@@ -147,18 +149,28 @@ class FleetWatcher:
         if name in self._last and answer["origin"] == self._origins.get(name):
             self._fill(robot, machine, self._last[name] + 1)
         else:
-            self._take(name, answer)
+            self._take(robot, machine, answer)
 
     def _snapshot(self, robot: str, machine: str) -> None:
         answer = self._state(robot, machine)
         if answer is not None:
-            self._take(fleet_name(robot, machine), answer)
+            self._take(robot, machine, answer)
 
-    def _take(self, name: str, answer: dict) -> None:
-        """Deliver a state answer's snapshot: the machine's whole state, from which its events go on."""
-        snapshot = answer["snapshot"]
+    def _take(self, robot: str, machine: str, answer: dict) -> None:
+        """A machine new to this watcher (or its robot's process is): every event from its first when
+        the robot still keeps them all (a dashboard restarted, or late, can look back over the whole
+        run), else the state answer's snapshot, from which its events go on."""
+        name = fleet_name(robot, machine)
         self.controls[name] = answer.get("controls")
         self._origins[name] = answer["origin"]
+        self._last.pop(name, None)
+        reply = first_reply(self.session, keys.history_key(robot, machine) + "?since=1", QUERY_TIMEOUT)
+        history = None if reply is None else loads(reply)
+        if history is not None and history["complete"] and history["events"]:
+            self._deliver(name, history["events"])
+            self.backfilled += 1
+            return
+        snapshot = answer["snapshot"]
         snapshot["machine"] = name
         snapshot["status"]["machine"] = name
         self.deliver([snapshot])

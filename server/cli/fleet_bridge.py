@@ -191,7 +191,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
             return
         entry.connected = alive.get(entry.name, True)
         entry.robot = entry.name.partition(":")[0]
-        if entry.remote is None and events[0]["kind"] == "snapshot":
+        if entry.remote is None:
             bind(entry)
 
     def bind(entry: MachineEntry) -> None:

@@ -113,6 +113,10 @@ class Proxy:
     def restore(self) -> None:
         self.open = True
 
+    def point_to(self, target: str) -> None:
+        """Connections from now on go to ``target`` (a dashboard that replaced another)."""
+        self.target = ("127.0.0.1", int(target.rsplit(":", 1)[1]))
+
     def close(self) -> None:
         self.cut()
         self.server.close()
@@ -142,7 +146,8 @@ class Dashboard:
         return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
 
     def stop(self) -> None:
-        os.killpg(self.proc.pid, signal.SIGTERM)  # a SIGINT is ignored by a process started in the background
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGTERM)  # a SIGINT is ignored by a process started in the background
         self.proc.wait(20)
 
 

@@ -72,6 +72,30 @@ def test_a_robot_process_cut_off_and_back_leaves_no_gap_in_the_dashboard(dashboa
         proxy.close()
 
 
+def test_a_dashboard_restarted_shows_the_robots_whole_run_and_controls_it(dashboard_with, tmp_path):
+    first = dashboard_with("--zenoh-token", "T")
+    proxy = Proxy(first.endpoint)
+    robot = Robot("r1", proxy.endpoint, "T", tmp_path / "r1.jsonl")
+    try:
+        wait_for(lambda: first.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol running")
+        second = dashboard_with("--zenoh-token", "T")
+        proxy.point_to(second.endpoint)  # the robot's link, when it comes back, reaches the new dashboard
+        proxy.cut()
+        first.stop()
+        proxy.restore()
+        wait_for(lambda: second.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol on the new one")
+        answer = second.post("/api/machines/r1:patrol/preempt", {})
+        assert answer.status_code == 202, answer.text
+        assert robot.ended() == 0
+        own = robot.events()
+        wait_for(lambda: second.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
+        seen = history(second, "r1:patrol", 1)
+        assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[:3], own[:3])
+    finally:
+        robot.stop()
+        proxy.close()
+
+
 def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leaves(dashboard_with):
     fsm.set_loggers(*(lambda msg: None,) * 4)
     dash = dashboard_with()

@@ -5,22 +5,26 @@
 
 The observer batches each machine's events in the machine's own thread (their bytes encoded once
 for every observer: ``fsm.observation.encoding.encoded``) and puts them on
-``fsmscope/<robot>/<machine>/events``: an event at once when the machine's last put is ``LINGER``
-old (a machine of a few events a second adds no delay), else with the others that come until then
-(a busy machine puts at most once per ``LINGER``, or per ``MAX_BATCH`` events); a flusher thread
-puts the batches the machine left when it went quiet. Puts drop rather than wait
-when the network is congested (Zenoh's ``CongestionControl.DROP``), so the machine never waits for
-the network; and no other thread touches each event (a hand-off to a sender thread cost the
-two-state loop about three times as much: the GIL and the cache lines moved between the threads,
-bench/fleet_cost.py). Per machine it also declares, on the machine's first event:
+``fsmscope/<robot>/<machine>/events`` on the robot's clock: at every tick (``LINGER``) the batches
+of all its machines go at the same instant, so Zenoh carries them in one message and a dashboard is
+woken once for them. A dashboard following 20 machines at 100 events/s took 31-33 % of a core so,
+against 45-48 % when each event was put as it came (bench/fleet_dashboard.py); an event waits 2.5 ms
+on average for the tick. A busy machine's thread puts its own batches (at the tick, or every
+``MAX_BATCH`` events), and no other thread touches its events: a hand-off of every event to a
+sender thread cost the two-state loop about three times as much, the GIL and the cache lines moving
+between the threads (bench/fleet_cost.py). A flusher thread puts the batches of the machines that
+wait for the tick. Puts drop rather than wait when the network is congested (Zenoh's
+``CongestionControl.DROP``), so a machine never waits for the network.
+
+Per machine it also declares, on the machine's first event:
 
 - a liveliness token on ``fsmscope/<robot>/<machine>``: dashboards see the machine appear, and
   see it gone within Zenoh's lease when the process dies or drops off the network;
 - a queryable ``.../state``: the machine's snapshot event (its whole state now), for a dashboard
   that joins late, and what controls it takes;
-- a queryable ``.../history?since=SEQ``: the batches put that hold the events from SEQ on, of the
-  newest ``RING`` events (a dashboard whose connection dropped fills its gap; older than that: it
-  takes the snapshot);
+- a queryable ``.../history?since=SEQ``: the events from SEQ on, of the newest ``RING`` (the batches
+  put that hold them, then those waiting for the tick): a dashboard whose connection dropped fills
+  its gap, one that joins takes the machine from its first event (older than that: the snapshot);
 - a queryable ``.../control``: a dashboard's control, carrying the robot's token, applied to the
   machine and answered (fleet/control.py).
 
@@ -50,8 +54,8 @@ from .control import RobotControls
 RING = 10_000  # events of each machine kept (as the batches put) for history queries
 MAX_BATCH = 512  # events per put at most (a payload of about 100 kB: larger ones cost more per byte to
                  # allocate, as fresh pages)
-LINGER = 0.005  # seconds between a machine's puts at least (fewer, larger puts: a dashboard following
-                # a fleet pays per put received, not per event)
+LINGER = 0.005  # seconds between the robot's puts (a tick of its clock: fewer, larger puts, together; a
+                # dashboard following a fleet pays per message received, not per event)
 
 
 class _Machine:
@@ -67,8 +71,7 @@ class _Machine:
         # The batch gathering, (seq, encoded event): the machine's thread appends without a lock (a
         # deque's append and popleft are atomic), whoever puts takes it holding ``putting``.
         self.pending: collections.deque[tuple[int, bytes]] = collections.deque()
-        self.last_put = -LINGER  # when the last batch was put (monotonic)
-        self.due = 0.0  # when the pending batch is put at the latest
+        self.due = 0.0  # when the pending batch is put: the robot's next tick
         self.putting = threading.Lock()  # one put at a time: batches go in order; guards the ring
         self.ring: collections.deque[tuple[int, int, int, bytes]] = collections.deque()  # (first, last, count, payload)
         self.kept = 0  # events in the ring
@@ -89,20 +92,17 @@ class _Machine:
         self.take((event["seq"], encoded(event)))
 
     def take(self, item: tuple[int, bytes]) -> None:
-        """In the machine's thread: an event, (seq, its JSON), is put at once if the last put is
-        ``LINGER`` old, else joins the pending batch, put when due or full (looked at every 16
-        events: a busy machine puts its own batches, the flusher those of a machine that went quiet).
-        The fewest steps: this is what publishing costs each step of a machine whose host encodes
-        its events anyway (ZenohRobot.follow)."""
+        """In the machine's thread: an event, (seq, its JSON), joins the pending batch, put at the
+        robot's next tick or when full (looked at every 16 events: a busy machine puts its own
+        batches, the flusher those of a machine that waits for the tick). The fewest steps: this is
+        what publishing costs each step of a machine whose host encodes its events anyway
+        (ZenohRobot.follow)."""
         pending = self.pending
         pending.append(item)
         n = len(pending)
         if n == 1:
-            self.due = self.last_put + LINGER
-            if monotonic() >= self.due:
-                self.flush()
-            else:
-                self.wake.set()
+            self.due = (monotonic() // LINGER + 1) * LINGER
+            self.wake.set()
         elif not n & 15 and (n >= MAX_BATCH or monotonic() >= self.due):
             self.flush()
 
@@ -118,7 +118,6 @@ class _Machine:
             items = [pending.popleft() for _ in range(len(pending))]
             payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
             self.publisher.put(payload)
-            self.last_put = monotonic()
             ring = self.ring
             ring.append((items[0][0], items[-1][0], len(items), payload))
             self.kept += len(items)
@@ -142,11 +141,15 @@ class _Machine:
             query.reply_err(b"since must be an integer")
             return
         with self.putting:
-            complete = bool(self.ring) and self.ring[0][0] <= since
-            payloads = [payload[1:-1] for first, last, count, payload in self.ring if last >= since]
-        # The batches holding the events from ``since`` on: the dashboard drops those before it had.
+            waiting = self.pending.copy()  # not put yet (a copy is atomic; the machine's thread appends)
+            first = self.ring[0][0] if self.ring else waiting[0][0] if waiting else None
+            parts = [payload[1:-1] for _, last, _, payload in self.ring if last >= since]
+        parts += [data for seq, data in waiting if seq >= since]
+        # The batches holding the events from ``since`` on (the dashboard drops those before it had),
+        # and the events waiting for the next tick.
+        complete = first is not None and first <= since
         query.reply(query.key_expr, b'{"complete":%s,"events":[%s]}' % (b"true" if complete else b"false",
-                                                                       b",".join(payloads)))
+                                                                       b",".join(parts)))
 
     def close(self) -> None:
         with self.putting:

@@ -97,7 +97,8 @@ def test_a_dashboard_that_joins_after_the_run_gets_the_whole_run_the_robot_keeps
 
 def test_a_dashboard_that_joins_after_the_robot_let_the_runs_start_go_gets_its_end_as_a_snapshot(quiet,
                                                                                                   monkeypatch):
-    monkeypatch.setattr(fleet.robot, "RING", 3)  # the batches of the first few events let go
+    monkeypatch.setattr(fleet.robot, "MAX_BATCH", 16)  # batches of 16 events (the size is looked at every 16)
+    monkeypatch.setattr(fleet.robot, "RING", 3)  # of which the robot keeps the newest
     endpoint = free_endpoint()
     robot = ZenohRobot("r1", listen=[endpoint])
     try:

@@ -48,52 +48,52 @@ def history(dash: Dashboard, name: str, since: int) -> list[dict]:
     return events
 
 
-def test_a_robot_process_cut_off_and_back_leaves_no_gap_in_the_dashboard(dashboard_with, tmp_path):
+def preempted_the_dashboard_has_the_robots_log(dash: Dashboard, robot: Robot, since: int) -> None:
+    """Preempt r1:patrol from ``dash``: its run ends, and the dashboard's events from ``since`` on are
+    those of the robot's own log."""
+    answer = dash.post("/api/machines/r1:patrol/preempt", {})
+    assert answer.status_code == 202, answer.text
+    assert robot.ended() == 0
+    own = [e for e in robot.events() if e["seq"] >= since]
+    wait_for(lambda: dash.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
+    seen = history(dash, "r1:patrol", since)
+    assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[-3:], own[-3:])
+
+
+@pytest.fixture
+def patrolling(dashboard_with, tmp_path):
+    """(a dashboard, the proxy between it and robot r1, r1): r1's patrol seen running."""
     dash = dashboard_with("--zenoh-token", "T")
     proxy = Proxy(dash.endpoint)
     robot = Robot("r1", proxy.endpoint, "T", tmp_path / "r1.jsonl")
     try:
         wait_for(lambda: dash.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol running")
-        first = dash.machines()["r1:patrol"]["last_seq"]
-        proxy.cut()
-        time.sleep(4.0)  # past the link's lease: the dashboard sees the robot gone, and it runs on unseen
-        assert dash.machines()["r1:patrol"]["connected"] is False
-        proxy.restore()
-        wait_for(lambda: dash.machines()["r1:patrol"]["connected"], 20, what="r1:patrol back")
-        answer = dash.post("/api/machines/r1:patrol/preempt", {})
-        assert answer.status_code == 202, answer.text
-        assert robot.ended() == 0
-        own = [e for e in robot.events() if e["seq"] > first]
-        wait_for(lambda: dash.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
-        seen = history(dash, "r1:patrol", first + 1)
-        assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[-3:], own[-3:])
+        yield dash, proxy, robot
     finally:
         robot.stop()
         proxy.close()
 
 
-def test_a_dashboard_restarted_shows_the_robots_whole_run_and_controls_it(dashboard_with, tmp_path):
-    first = dashboard_with("--zenoh-token", "T")
-    proxy = Proxy(first.endpoint)
-    robot = Robot("r1", proxy.endpoint, "T", tmp_path / "r1.jsonl")
-    try:
-        wait_for(lambda: first.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol running")
-        second = dashboard_with("--zenoh-token", "T")
-        proxy.point_to(second.endpoint)  # the robot's link, when it comes back, reaches the new dashboard
-        proxy.cut()
-        first.stop()
-        proxy.restore()
-        wait_for(lambda: second.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol on the new one")
-        answer = second.post("/api/machines/r1:patrol/preempt", {})
-        assert answer.status_code == 202, answer.text
-        assert robot.ended() == 0
-        own = robot.events()
-        wait_for(lambda: second.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
-        seen = history(second, "r1:patrol", 1)
-        assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[:3], own[:3])
-    finally:
-        robot.stop()
-        proxy.close()
+def test_a_robot_process_cut_off_and_back_leaves_no_gap_in_the_dashboard(patrolling):
+    dash, proxy, robot = patrolling
+    first = dash.machines()["r1:patrol"]["last_seq"]
+    proxy.cut()
+    time.sleep(4.0)  # past the link's lease: the dashboard sees the robot gone, and it runs on unseen
+    assert dash.machines()["r1:patrol"]["connected"] is False
+    proxy.restore()
+    wait_for(lambda: dash.machines()["r1:patrol"]["connected"], 20, what="r1:patrol back")
+    preempted_the_dashboard_has_the_robots_log(dash, robot, first + 1)
+
+
+def test_a_dashboard_restarted_shows_the_robots_whole_run_and_controls_it(patrolling, dashboard_with):
+    first, proxy, robot = patrolling
+    second = dashboard_with("--zenoh-token", "T")
+    proxy.point_to(second.endpoint)  # the robot's link, when it comes back, reaches the new dashboard
+    proxy.cut()
+    first.stop()
+    proxy.restore()
+    wait_for(lambda: second.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol on the new one")
+    preempted_the_dashboard_has_the_robots_log(second, robot, 1)
 
 
 def test_a_robot_machine_appears_in_the_dashboard_and_is_shown_gone_when_it_leaves(dashboard_with):
@@ -193,22 +193,15 @@ sm.execute()
 """
 
 
-def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_path, watching):
+@pytest.mark.parametrize("serving", [["--no-serve"], ["--exit"]],
+                         ids=["the robot observes the machine", "the robot follows the served dashboard's hub"])
+def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_path, watching, serving):
     endpoint, seen = watching
     script = tmp_path / "pick.py"
     script.write_text(SCRIPT)
-    last = published(["run", str(script), "--no-serve", "--zenoh", "arm2"], tmp_path / "pick.jsonl", endpoint)
+    last = published(["run", str(script), *serving, "--zenoh", "arm2"], tmp_path / "pick.jsonl", endpoint)
     wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
     assert {e["machine"] for e in seen} == {"arm2:pick"}
-
-
-def test_a_script_run_and_served_with_zenoh_publishes_the_events_its_dashboard_encodes(tmp_path, watching):
-    endpoint, seen = watching
-    script = tmp_path / "pick.py"
-    script.write_text(SCRIPT)
-    last = published(["run", str(script), "--exit", "--zenoh", "arm3"], tmp_path / "pick.jsonl", endpoint)
-    wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
-    assert {e["machine"] for e in seen} == {"arm3:pick"}
 
 
 def test_a_script_that_never_closes_its_robot_still_exits(tmp_path):

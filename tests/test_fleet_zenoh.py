@@ -79,39 +79,36 @@ def test_a_dashboard_there_first_gets_every_event_in_order(quiet):
         dash.watcher.close()
 
 
-def test_a_dashboard_that_joins_after_the_run_gets_the_whole_run_the_robot_keeps(quiet):
+def run_then_join() -> tuple[list[dict], Dashboard]:
+    """A robot runs its machine to the end, then a dashboard joins: the robot's own events, and the
+    dashboard with what it was given first."""
     endpoint = free_endpoint()
     robot = ZenohRobot("r1", listen=[endpoint])
     try:
         own = run_on(robot, slow_loop(10, 0.0))
         dash = Dashboard(connect=[endpoint])
         try:
-            wait_for(lambda: dash.events, 10, what="the run")
-            assert [e["seq"] for e in dash.events] == [e["seq"] for e in own]
-            assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
+            wait_for(lambda: dash.events, 10, what="the machine")
         finally:
             dash.watcher.close()
     finally:
         robot.close()
+    return own, dash
+
+
+def test_a_dashboard_that_joins_after_the_run_gets_the_whole_run_the_robot_keeps(quiet):
+    own, dash = run_then_join()
+    assert [e["seq"] for e in dash.events] == [e["seq"] for e in own]
+    assert dash.status("r1:loop").to_dict() == dict(own_status(own), machine="r1:loop")
 
 
 def test_a_dashboard_that_joins_after_the_robot_let_the_runs_start_go_gets_its_end_as_a_snapshot(quiet,
                                                                                                   monkeypatch):
     monkeypatch.setattr(fleet.robot, "MAX_BATCH", 16)  # batches of 16 events (the size is looked at every 16)
     monkeypatch.setattr(fleet.robot, "RING", 3)  # of which the robot keeps the newest
-    endpoint = free_endpoint()
-    robot = ZenohRobot("r1", listen=[endpoint])
-    try:
-        own = run_on(robot, slow_loop(10, 0.0))
-        dash = Dashboard(connect=[endpoint])
-        try:
-            wait_for(lambda: dash.events, 10, what="a snapshot")
-            assert [e["kind"] for e in dash.events] == ["snapshot"] and dash.events[0]["seq"] == own[-1]["seq"]
-            assert dash.events[0]["status"]["outcome"] == "done"
-        finally:
-            dash.watcher.close()
-    finally:
-        robot.close()
+    own, dash = run_then_join()
+    assert [e["kind"] for e in dash.events] == ["snapshot"] and dash.events[0]["seq"] == own[-1]["seq"]
+    assert dash.events[0]["status"]["outcome"] == "done"
 
 
 def test_a_robot_that_leaves_is_seen_gone_and_seen_back(quiet):

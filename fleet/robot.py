@@ -111,7 +111,10 @@ class _Machine:
         batch still pending is due, None when none is."""
         with self.putting:
             pending = self.pending
-            if not pending or self.closed:
+            if self.closed:  # the robot left the network: what its machine still does goes nowhere
+                pending.clear()
+                return None
+            if not pending:
                 return None
             if now is not None and now < self.due:
                 return self.due
@@ -186,6 +189,8 @@ class ZenohRobot:
         try:
             machine = self._machines[event["machine"]]
         except KeyError:
+            if self._stop.is_set():  # closed: the machine runs on, unpublished
+                return
             machine = self._declare(event["machine"])
         machine.keep(event)
 

@@ -5,12 +5,13 @@ A machine is found by its liveliness token (``fsmscope/<robot>/<machine>``, with
 those alive before the dashboard came too). On finding one the watcher asks its ``.../state``
 and its ``.../history`` from the first event: when the robot still keeps every event of the machine
 it delivers them all (a dashboard that joins late, or restarted, sees the whole run), else the
-state's snapshot; then it delivers the machine's events from ``.../events`` in seq order. An event beyond the next one expected (batches were lost while the network was down)
-makes it ask ``.../history?since=`` for the missing ones first; when the robot no longer keeps
-them, it takes a new snapshot instead. A token withdrawn (the robot's process ended, or dropped off
-the network past Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine:
-with the events it missed when its process is the same (its session's id, which the state answer
-carries), with a new snapshot when the process is a new one (its seqs start again).
+state's snapshot; then it delivers the machine's events from ``.../events`` in seq order. An event
+beyond the next one expected (batches were lost while the network was down) makes it ask
+``.../history?since=`` for the missing ones first; when the robot no longer keeps them, it takes a
+new snapshot instead. A token withdrawn (the robot's process ended, or dropped off the network past
+Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine: with the events it
+missed when its process is the same (its session's id, which the state answer carries), taken
+again (from its first event, or a snapshot) when the process is a new one (its seqs start again).
 
 Each delivered event carries the dashboard's name of the machine, ``<robot>:<machine>``: machines
 of different robots may share a name. Two threads of the watcher's read Zenoh's channels (bounded:

@@ -219,3 +219,22 @@ def test_two_dashboards_watch_the_same_robot_and_each_gets_every_event(quiet):
         robot.close()
         for dash in dashes:
             dash.watcher.close()
+
+
+def test_a_closed_robot_keeps_no_more_than_a_batch_of_what_its_machine_still_does(quiet):
+    robot = ZenohRobot("r1")
+    sm = slow_loop(400, 0.0)
+    fsm.attach(sm, robot, name="loop")
+    sm.execute()
+    robot.close()
+    sm.get_children()["A"].count[0] = 0  # the loop ticks its 400 times again
+    sm.execute()
+    assert len(robot._machines["loop"].pending) < fleet.robot.MAX_BATCH
+
+
+def test_a_machine_that_first_runs_after_its_robot_closed_runs_unpublished(quiet):
+    robot = ZenohRobot("r1")
+    sm = slow_loop(4, 0.0)
+    fsm.attach(sm, robot, name="loop")
+    robot.close()
+    assert sm.execute() == "done" and "loop" not in robot._machines

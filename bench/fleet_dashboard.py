@@ -2,7 +2,8 @@
 events/s, published on Zenoh (loopback, explicit tcp endpoints, no multicast) into one real
 ``fsmscope serve --zenoh`` process, watched by real Chromium. Two views: an operator's (the fleet
 overview open, and the dashboard page of one machine, whose events are timed), then the heaviest
-(the streams of all 20 machines into one page, every event timed).
+(the streams of all 20 machines into one page, every event timed). The pages are ones Playwright
+does not follow (bench/quiet_page.py): it would have Chromium report it every websocket frame.
 
 Measured in the page: event-to-browser latency, from the event's ``t`` (the robot's clock, when the
 machine emitted it) to its arrival in the page (``Date.now()``, the same host's clock). Measured on
@@ -30,6 +31,7 @@ ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 sys.path.insert(0, ROOT)
 
 from server.testing.demo_process import free_endpoint  # noqa: E402
+from quiet_page import QuietPage  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 ROBOTS = 5
@@ -140,17 +142,15 @@ def main() -> None:
         names = ["r%d:m%d" % (r, m) for r in range(1, ROBOTS + 1) for m in range(MACHINES)]
         with sync_playwright() as pw:
             browser = launch_chromium(pw)
-            page = browser.new_page()
-            page.goto(found.group(1))
-            page.wait_for_function("(n) => window.fsmscopeFleet.tiles.filter((t) => t.state === 'running').length === n",
-                                   arg=len(names), timeout=60000)
-            shown = browser.new_page()
-            shown.goto(found.group(1).replace("/fleet?", "/?") + "#m=" + names[0])
-            shown.wait_for_selector("#badge.live")
+            page = QuietPage(browser, found.group(1))
+            page.wait_for("(n) => window.fsmscopeFleet.tiles.filter((t) => t.state === 'running').length === n",
+                          len(names))
+            shown = QuietPage(browser, found.group(1).replace("/fleet?", "/?") + "#m=" + names[0])
+            shown.wait_for("() => document.querySelector('#badge.live') !== null")
             shown.evaluate(PAGE_STREAMS, names[:1])  # timed in the machine's own page, busy drawing them
             operator = windows(shown, dash.pid, args)
             shown.close()
-            page.evaluate(PAGE_STREAMS, names[1:])
+            page.evaluate(PAGE_STREAMS, names)
             heaviest = windows(page, dash.pid, args)
             browser.close()
         without = [clients(found.group(1), names, dash.pid, args.seconds) for _ in range(args.windows)]
@@ -209,7 +209,7 @@ def clients(fleet_url: str, names: list[str], pid: int, seconds: float) -> dict:
     return {"rate": len(ordered) / elapsed, "p50": at(0.5), "p99": at(0.99), "max": ordered[-1], "cpu": share}
 
 
-def windows(page, pid: int, args: argparse.Namespace) -> list[dict]:
+def windows(page: QuietPage, pid: int, args: argparse.Namespace) -> list[dict]:
     """``args.windows`` windows of ``args.seconds``: each the page's latencies and the dashboard's CPU share."""
     time.sleep(3.0)  # the new streams' snapshots and first events
     page.evaluate(PAGE_WINDOW)

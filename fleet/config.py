@@ -15,9 +15,11 @@ LEASE_MS = 3000  # a link silent this long is dropped: the machines behind it ar
 def session_config(connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
                    scouting: bool = False) -> zenoh.Config:
     """``connect`` / ``listen``: endpoints such as ``tcp/127.0.0.1:7447``; ``mode``: "peer" or
-    "client" (through a zenohd router); ``scouting``: find peers on the LAN by multicast."""
-    if mode not in ("peer", "client"):
-        raise ValueError("mode must be peer or client, not %r" % mode)
+    "client" (through a zenohd router), or "router" (routes for its clients, as zenohd does: the
+    tests' stand-in for zenohd, which is not a Python package); ``scouting``: find peers on the LAN
+    by multicast."""
+    if mode not in ("peer", "client", "router"):
+        raise ValueError("mode must be peer, client or router, not %r" % mode)
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps(mode))
     config.insert_json5("scouting/multicast/enabled", json.dumps(scouting))

@@ -3,8 +3,8 @@ VENV     := .venv
 PY       := $(VENV)/bin/python
 STAMP    := $(VENV)/.installed
 # Debian packages the tests and the demo need: Graphviz's dot for graph layout, Chromium and
-# Firefox ESR for the browser tests.
-APT_PKGS := graphviz chromium firefox-esr fonts-dejavu-core
+# Firefox ESR for the browser tests, openssl for the fleet's TLS test certificates.
+APT_PKGS := graphviz chromium firefox-esr fonts-dejavu-core openssl
 
 .PHONY: install apt demo test bench clean
 

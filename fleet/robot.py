@@ -164,15 +164,17 @@ class _Machine:
 class ZenohRobot:
     """An observer (``fsm.attach(sm, ZenohRobot("r1", ...))``) that puts a robot's machines on Zenoh.
     ``connect`` / ``listen``: Zenoh endpoints (``tcp/HOST:PORT``); ``mode``: "peer" or "client";
-    ``scouting``: multicast discovery on the LAN (off unless asked). ``token``: what a dashboard's
-    control must carry (none: the robot takes no control); ``can_start``: whether a start may run a
-    machine again (in a new thread)."""
+    ``scouting``: multicast discovery on the LAN (off unless asked); ``config_file``: a Zenoh
+    configuration file under those (fleet/config.py). ``token``: what a dashboard's control must
+    carry (none: the robot takes no control); ``can_start``: whether a start may run a machine again
+    (in a new thread)."""
 
     def __init__(self, robot: str, connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
-                 scouting: bool = False, token: str | None = None, can_start: bool = False) -> None:
+                 scouting: bool = False, token: str | None = None, can_start: bool = False,
+                 config_file: str | None = None) -> None:
         self.robot = keys.chunk(robot, "robot")
         self.can_start = can_start
-        self.session = zenoh.open(session_config(connect, listen, mode, scouting))
+        self.session = zenoh.open(session_config(connect, listen, mode, scouting, config_file))
         self.controls = RobotControls(token, self.flush)
         self._stop = threading.Event()
         self._wake = threading.Event()  # a batch began: the flusher puts it if its machine goes quiet

@@ -54,10 +54,10 @@ class FleetWatcher:
 
     def __init__(self, deliver: Callable[[list[dict]], None], alive: Callable[[str, bool], None],
                  connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
-                 scouting: bool = False) -> None:
+                 scouting: bool = False, config_file: str | None = None) -> None:
         self.deliver = deliver
         self.alive = alive
-        self.session = zenoh.open(session_config(connect, listen, mode, scouting))
+        self.session = zenoh.open(session_config(connect, listen, mode, scouting, config_file))
         self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
         self.controls: dict[str, dict | None] = {}  # machine -> what its robot said of its controls
         self._origins: dict[str, str] = {}  # machine -> the session id of the robot's process

@@ -52,6 +52,20 @@ def add_zenoh_arguments(parser: argparse.ArgumentParser, publish: bool) -> None:
                         help="with --zenoh: peer (default), or client of a zenohd router")
     parser.add_argument("--zenoh-scouting", action="store_true",
                         help="with --zenoh: find the others on the LAN by multicast (off unless asked)")
+    parser.add_argument("--zenoh-config", type=zenoh_config_file, metavar="FILE",
+                        help="with --zenoh: a Zenoh configuration file (JSON5) for the rest, such as TLS "
+                             "certificates for tls/ endpoints; the options above are applied over it")
+
+
+def zenoh_config_file(path: str) -> str:
+    """``--zenoh-config``'s check: a file Zenoh reads as its configuration (else the command says why)."""
+    from fleet.config import read_config_file
+
+    try:
+        read_config_file(path)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return path
 
 
 TOKEN_ENV = "FSMSCOPE_ZENOH_TOKEN"
@@ -81,7 +95,7 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
         print("fsmscope: the token of robot %r's controls: %s (serve --zenoh-token %s=%s)"
               % (args.zenoh, token, args.zenoh, token), file=sys.stderr, flush=True)
     robot = ZenohRobot(args.zenoh, connect=args.zenoh_connect, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                       scouting=args.zenoh_scouting, token=token, can_start=can_start)
+                       scouting=args.zenoh_scouting, token=token, can_start=can_start, config_file=args.zenoh_config)
     print("fsmscope: publishing on Zenoh as robot %r" % args.zenoh, file=sys.stderr, flush=True)
     return robot
 
@@ -212,7 +226,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
 
     watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),
                            connect=args.zenoh, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                           scouting=args.zenoh_scouting)
+                           scouting=args.zenoh_scouting, config_file=args.zenoh_config)
     print("fsmscope: following the fleet on Zenoh (%s)" % ", ".join(
         ["connect " + e for e in args.zenoh] + ["listen " + e for e in args.zenoh_listen]
         + (["multicast scouting"] if args.zenoh_scouting else [])) or "no endpoint", file=sys.stderr, flush=True)

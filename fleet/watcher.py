@@ -18,7 +18,8 @@ of different robots may share a name. Two threads of the watcher's read Zenoh's 
 the events' drops its oldest batch when full, and the gap is filled from history after) and handle
 what they read one at a time, under one lock: deliver, ask the queries. A thread asking a query
 leaves its channel to fill meanwhile; no other hop is taken per batch (each costs a fleet's
-dashboard more than the batch's events do).
+dashboard more than the batch's events do). A reader handles what its channel holds before it says
+``settled``: the robots put on the same tick, and the dashboard's loop is woken once for them.
 
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
 sends a control to the machine's robot (fleet/control.py). The watcher's liveliness token
@@ -41,6 +42,7 @@ from .query import first_reply
 
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
 QUEUE = 10_000  # samples waiting in a channel for the watcher's thread before the oldest are dropped
+BURST = 64  # samples handled at most before ``settled`` is called, when they keep coming
 
 
 def fleet_name(robot: str, machine: str) -> str:
@@ -50,13 +52,17 @@ def fleet_name(robot: str, machine: str) -> str:
 
 class FleetWatcher:
     """Follows every machine of the fleet: ``deliver(events)`` for each snapshot and batch of events
-    (renamed, in order: one machine's per call), ``alive(name, bool)`` as machines come and go."""
+    (renamed, in order: one machine's per call), ``alive(name, bool)`` as machines come and go, and
+    ``settled()`` after the calls of the samples that came together (the robots' puts of one tick):
+    a consumer that hands the calls to another thread wakes it then, once for them all."""
 
     def __init__(self, deliver: Callable[[list[dict]], None], alive: Callable[[str, bool], None],
                  connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
-                 scouting: bool = False, config_file: str | None = None) -> None:
+                 scouting: bool = False, config_file: str | None = None,
+                 settled: Callable[[], None] = lambda: None) -> None:
         self.deliver = deliver
         self.alive = alive
+        self.settled = settled
         self.session = zenoh.open(session_config(connect, listen, mode, scouting, config_file))
         self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
         self.controls: dict[str, dict | None] = {}  # machine -> what its robot said of its controls
@@ -96,11 +102,19 @@ class FleetWatcher:
     def __exit__(self, *exc: object) -> None:
         self.close()
 
-    @staticmethod
-    def _read(subscriber: zenoh.Subscriber, handle: Callable[[zenoh.Sample], None]) -> None:
+    def _read(self, subscriber: zenoh.Subscriber, handle: Callable[[zenoh.Sample], None]) -> None:
+        """Handle the channel's samples as they come, and call ``settled`` once those that came
+        together are handled (every ``BURST`` of a flood, at least)."""
+        channel = subscriber.handler  # not the subscriber itself: one borrowed by a wait cannot be undeclared
         try:
-            for sample in subscriber:
-                handle(sample)
+            while True:
+                handle(channel.recv())
+                for _ in range(BURST - 1):
+                    sample = channel.try_recv()
+                    if sample is None:
+                        break
+                    handle(sample)
+                self.settled()
         except zenoh.ZError:  # the session closed
             pass
 

@@ -151,13 +151,11 @@ class FleetLink:
                 file=sys.stderr, flush=True)
 
 
-LINGER = 0.002  # seconds the loop lets the fleet's calls gather before it runs them
-
-
 class LoopInbox:
-    """What the watcher's thread hands to the event loop, in order: calls queued, and run together
-    ``LINGER`` after the first of them (a fleet's thousands of batches a second wake the loop a few
-    hundred times, not once per batch: each wake costs it more than ingesting an event does)."""
+    """What the watcher's threads hand to the event loop, in order: calls queued, run together when the
+    watcher says the samples that came together are handled (``wake``). A fleet's robots put on the
+    same tick, so its thousands of batches a second wake the loop a few hundred times, not once per
+    batch: each wake costs the loop more than ingesting an event does."""
 
     def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
         self.loop = loop
@@ -166,19 +164,23 @@ class LoopInbox:
         self._scheduled = False
 
     def post(self, call: Callable[..., None], *args: object) -> None:
-        """From any thread: ``call(*args)`` on the loop, after those posted before it."""
+        """From any thread: ``call(*args)`` on the loop, after those posted before it, at the next ``wake``."""
+        self._calls.append((call, args))
+
+    def wake(self) -> None:
+        """From any thread: run what was posted, unless the loop is about to."""
         with self._lock:
-            self._calls.append((call, args))
-            if self._scheduled:
+            if self._scheduled or not self._calls:
                 return
             self._scheduled = True
-        self.loop.call_soon_threadsafe(self.loop.call_later, LINGER, self._run)
+        self.loop.call_soon_threadsafe(self._run)
 
     def _run(self) -> None:
         with self._lock:
-            calls, self._calls = self._calls, collections.deque()
             self._scheduled = False
-        for call, args in calls:
+        calls = self._calls
+        while calls:
+            call, args = calls.popleft()
             call(*args)
 
 
@@ -226,7 +228,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
 
     watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),
                            connect=args.zenoh, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                           scouting=args.zenoh_scouting, config_file=args.zenoh_config)
+                           scouting=args.zenoh_scouting, config_file=args.zenoh_config, settled=inbox.wake)
     print("fsmscope: following the fleet on Zenoh (%s)" % ", ".join(
         ["connect " + e for e in args.zenoh] + ["listen " + e for e in args.zenoh_listen]
         + (["multicast scouting"] if args.zenoh_scouting else [])) or "no endpoint", file=sys.stderr, flush=True)

@@ -48,6 +48,7 @@ bench: install
 	$(PY) bench/bag_import.py
 	$(PY) bench/mcap_export.py
 	$(PY) bench/fleet_cost.py
+	$(PY) bench/fleet_dashboard.py
 
 clean:
 	rm -rf $(VENV) *.egg-info .pytest_cache

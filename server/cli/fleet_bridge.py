@@ -179,7 +179,7 @@ class LoopInbox:
         with self._lock:
             self._scheduled = False
         calls = self._calls
-        while calls:
+        for _ in range(len(calls)):  # those posted meanwhile come with a wake of their own
             call, args = calls.popleft()
             call(*args)
 

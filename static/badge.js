@@ -1,5 +1,7 @@
 // The connection badge: the stream's state, its event rate and latency, the events it missed.
 
+import { setText } from "./dom.js";
+
 /**
  * @param {HTMLElement} badge the badge
  * @param {Stream|null} stream the stream of the machine shown (stream.js)
@@ -28,5 +30,5 @@ export function showBadge(badge, stream, { online, replay }) {
   badge.className = "badge " + cls;
   badge.dataset.state = state;
   const label = badge.querySelector(".badge-text");
-  if (label.textContent !== text) label.textContent = text;
+  setText(label, text);
 }

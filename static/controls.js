@@ -4,6 +4,7 @@
 
 import { api } from "./api.js";
 import { confirmPreempt, editInitialState } from "./dialogs.js";
+import { setText } from "./dom.js";
 import { heldText } from "./loop.js";
 import { controlRefusal } from "./machines.js";
 import { notice } from "./notice.js";
@@ -56,7 +57,7 @@ export class Controls {
     hold.disabled = !live || !running || !controllable || entry.held;
     const loop = $("loop-state");
     loop.hidden = !entry?.held;
-    if (loop.textContent !== heldText(running)) loop.textContent = heldText(running);
+    setText(loop, heldText(running));
   }
 
   /** The menu item "Set as initial state…" for the state at `path`. */

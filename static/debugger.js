@@ -5,6 +5,7 @@
 
 import { api } from "./api.js";
 import { showMenu } from "./dialogs.js";
+import { setText } from "./dom.js";
 import { debugLine } from "./transcript.js";
 
 const $ = (id) => document.getElementById(id);
@@ -50,7 +51,7 @@ export class DebugBar {
     const bar = $("debug-bar");
     bar.hidden = text === null;
     const what = bar.querySelector(".debug-text");
-    if (text !== null && what.textContent !== text) what.textContent = text;
+    if (text !== null) setText(what, text);
     const now = this.store.status?.debug ?? { mode: "run", holds: [] };
     const paused = now.mode !== "run" || now.holds.length > 0;
     const can = this.live() && !this.controls.refusal();

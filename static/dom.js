@@ -15,6 +15,12 @@ export function h(tag, props = {}, ...children) {
   return el;
 }
 
+/** Set `el`'s text only when it changes: a text written again, even the same, is laid out again,
+ * and outside a contained pane that is a layout of the whole page at every frame. */
+export function setText(el, text) {
+  if (el.textContent !== text) el.textContent = text;
+}
+
 /**
  * Give `cls` to exactly the elements that `find` returns for `keys`, touching only those that
  * change (a class set again is still a style recalculation, and a frame has many).

@@ -3,6 +3,7 @@
 // (#q=TEXT&state=failed&sort=state), each tile a link to that machine's full dashboard.
 
 import { api } from "./api.js";
+import { setText } from "./dom.js";
 import { FleetTiles } from "./fleet_tiles.js";
 import { countStates, STATES, visibleTiles } from "./fleet_view.js";
 import { streamProtocols } from "./token.js";
@@ -37,7 +38,7 @@ function render() {
   const counts = countStates(latest.tiles);
   const summary = [`${latest.tiles.length} machine${latest.tiles.length === 1 ? "" : "s"}`,
     ...STATES.filter((s) => counts[s]).map((s) => `${counts[s]} ${s === "done" ? "finished" : s}`)].join(" · ");
-  if ($("fleet-summary").textContent !== summary) $("fleet-summary").textContent = summary;
+  setText($("fleet-summary"), summary);
   $("empty").hidden = shown.length > 0;
   $("empty").textContent = latest.tiles.length ? "No machine matches." : "No machine yet.";
 }

@@ -6,6 +6,7 @@
 
 import { api } from "./api.js";
 import { clockText } from "./clocktext.js";
+import { setText } from "./dom.js";
 import { notice } from "./notice.js";
 
 const $ = (id) => document.getElementById(id);
@@ -108,9 +109,9 @@ export class Lease {
       text = "nobody controls";
       title = `No page controls ${this.name}: the first to use a control takes it.`;
     }
-    if (pill.textContent !== text) pill.textContent = text;
+    setText(pill, text);
     pill.title = title;
     pill.className = "pill lease " + (s.yours ? "yours" : s.holder ? "other" : "free");
-    take.textContent = s.holder ? "Take control over" : "Take control";
+    setText(take, s.holder ? "Take control over" : "Take control");
   }
 }

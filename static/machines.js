@@ -5,7 +5,7 @@ import { api, ApiError } from "./api.js";
 import { readLink, writeLink } from "./deeplink.js";
 import { holdChange } from "./loop.js";
 import { banner } from "./notice.js";
-import { h } from "./dom.js";
+import { h, setText } from "./dom.js";
 import { SOURCES } from "./schema.js";
 
 const POLL_MS = 2000;
@@ -42,7 +42,7 @@ export function showRunState(pill, s, entry) {
   let text = known ? state : "—";
   if (state === "failed") text = "failed: " + (s.error.exc_type || "error");
   if (state === "done") text = "finished: " + s.outcome;
-  if (pill.textContent !== text) pill.textContent = text;
+  setText(pill, text);
   pill.className = "pill " + state;
   pill.title = s?.error ? `${s.error.exc_type || ""} ${s.error.message || ""}`.trim() : "";
 }

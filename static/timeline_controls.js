@@ -2,7 +2,7 @@
 // and the line that says which instant is shown ("live" or "viewing the past: ..."). Buttons and keys
 // call the same Timeline actions; the keys work anywhere in the page but in a text field.
 
-import { h } from "./dom.js";
+import { h, setText } from "./dom.js";
 import { clockText } from "./clocktext.js";
 
 export const SPEEDS = [0.1, 0.25, 0.5, 1, 2, 5, 10];
@@ -65,16 +65,16 @@ export class TimelineControls {
   show(instant, liveMachine, data) {
     const { t, live, behind, playing } = instant;
     const e = this.el;
-    if (live) e.status.textContent = "live";
-    else if (t === null) e.status.textContent = data && !data.first ? "no events yet" : "";
+    if (live) setText(e.status, "live");
+    else if (t === null) setText(e.status, data && !data.first ? "no events yet" : "");
     else {
       const count = behind === null ? "" : `, ${behind} event${behind === 1 ? "" : "s"} behind`;
-      e.status.textContent = `viewing the past: ${clockText(t)}${count}`;
+      setText(e.status, `viewing the past: ${clockText(t)}${count}`);
     }
     e.status.classList.toggle("past", !live && t !== null);
-    e.kept.textContent = data?.first ? keptText(data.first, data.keptFrom, data.historyFrom) : "";
+    setText(e.kept, data?.first ? keptText(data.first, data.keptFrom, data.historyFrom) : "");
     e.live.hidden = live || !liveMachine;
-    e.play.textContent = playing ? "❚❚" : "▶";
+    setText(e.play, playing ? "❚❚" : "▶");
     e.play.title = playing ? "Pause (Space)" : "Play (Space)";
   }
 

@@ -1,7 +1,7 @@
 // The side panel's tree of the hierarchy.
 // Every name, value and message goes in as text (createElement + textContent), never as HTML.
 
-import { h, markExactly } from "./dom.js";
+import { h, markExactly, setText } from "./dom.js";
 
 /** The tree of the hierarchy; rows are built once per structure, status only toggles classes, on the
  * rows whose marks change (per frame the work is O(active states), never O(states)). */
@@ -102,7 +102,7 @@ export class TreeView {
     for (const path of new Set([...this.outcomes.keys(), ...outcomes.keys()])) {
       const out = this.rows.get(path)?.lastElementChild;
       const text = outcomes.get(path) ?? "";
-      if (out && out.textContent !== text) out.textContent = text;
+      if (out) setText(out, text);
     }
     this.outcomes = outcomes;
   }

@@ -26,12 +26,14 @@ import statistics
 import subprocess
 import sys
 import time
+from typing import Callable
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 sys.path.insert(0, ROOT)
 
 import fleet.robot  # noqa: E402
 import fsm  # noqa: E402
+import runtime  # noqa: E402
 from fleet.robot import ZenohRobot  # noqa: E402
 from runtime import two_state_loop  # noqa: E402
 from server.cli.fleet_bridge import robot_follows  # noqa: E402
@@ -62,12 +64,32 @@ threading.Event().wait()
 """
 
 
-def rate(srv: ServerThread, robot: ZenohRobot | None) -> float:
-    """Transitions/s of one run of the loop, served by ``srv`` and published by ``robot`` (if any)."""
+WARM_UP = 2_000  # transitions run first, untimed: a watcher joins the new machine meanwhile
+JOINING = 1.0  # s given to the watcher to join (ask the machine's state and its history, once)
+
+
+def prepared(srv: ServerThread, robot: ZenohRobot | None) -> Callable[[], int]:
+    """A new two-state loop served by ``srv`` and published by ``robot`` (if any), warmed up: its
+    ``run``. Each round's machine is a new one, and a watcher following the robot joins it (asks its
+    state and the history the robot keeps, once), as a dashboard does once per machine: that is done
+    here, in every case alike, so that the timed run is that of a machine being followed."""
     sm, run = two_state_loop()
     entry = srv.hub.add_local(sm, name="loop-%d" % time.monotonic_ns())
     if robot is not None:  # as `fsmscope run --zenoh` composes them (server/cli/fleet_bridge.py)
         robot_follows(robot, entry)
+    timed, runtime.LOOP_TRANSITIONS = runtime.LOOP_TRANSITIONS, WARM_UP
+    try:
+        run()
+    finally:
+        runtime.LOOP_TRANSITIONS = timed
+    if robot is not None:
+        robot.flush()
+    time.sleep(JOINING)
+    return run
+
+
+def timed_rate(run: Callable[[], int], robot: ZenohRobot | None) -> float:
+    """Transitions/s of one run of a ``prepared`` loop."""
     start = time.perf_counter()
     count = run()
     elapsed = time.perf_counter() - start
@@ -76,10 +98,16 @@ def rate(srv: ServerThread, robot: ZenohRobot | None) -> float:
     return count / elapsed
 
 
+def rate(srv: ServerThread, robot: ZenohRobot | None) -> float:
+    """Transitions/s of a new loop, warmed up, published by ``robot`` (if any)."""
+    return timed_rate(prepared(srv, robot), robot)
+
+
 def followed_rate(srv: ServerThread, robot: ZenohRobot, watcher: subprocess.Popen, cpu: list[float]) -> float:
-    """``rate`` with the watcher following: the share of a core it took meanwhile goes to ``cpu``."""
+    """``rate`` with the watcher following: the share of a core it took during the timed run goes to ``cpu``."""
+    run = prepared(srv, robot)
     before, start = cpu_seconds(watcher.pid), time.perf_counter()
-    result = rate(srv, robot)
+    result = timed_rate(run, robot)
     cpu.append((cpu_seconds(watcher.pid) - before) / (time.perf_counter() - start))
     return result
 
@@ -98,8 +126,8 @@ COUNTED = 20_000  # transitions of a run under callgrind (about 50 times slower)
 
 
 def loop_once(with_robot: bool, transitions: int) -> None:
-    """One run of the loop with the hub, and the robot if asked: what callgrind counts."""
-    import runtime
+    """One run of the loop with the hub, and the robot if asked: what callgrind counts (the warm-up's
+    instructions are in the runs of ``transitions`` and of none alike)."""
     runtime.LOOP_TRANSITIONS = transitions
     fleet.robot.LINGER = 1.0  # callgrind slows the loop: batches as full as at full speed (MAX_BATCH)
     fsm.set_loggers(*[lambda msg: None] * 4)

@@ -48,8 +48,10 @@ export class RunNotices {
   /** What event `ev` of machine `name`, whose root is at `rootPath`, has the notice say. */
   event(ev, name, rootPath) {
     if (ev.kind === "start" && ev.path === rootPath && this.finishedText) {
+      // The previous run's outcome no longer describes the machine; what else the notice says (the
+      // answer to the Start that began this run may come before or after its first event) stays.
+      if ($("notice").textContent.includes(this.finishedText)) clearNotice();
       this.finishedText = null;
-      clearNotice(); // the previous run's outcome no longer describes the machine
     } else if (ev.kind === "terminate" && ev.path === rootPath) {
       const outcome = ev.outcome === null ? "no outcome" + (ev.error ? ` (${ev.error})` : "") : `outcome '${ev.outcome}'`;
       this.finishedText = `${name} finished: ${outcome}`;

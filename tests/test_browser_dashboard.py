@@ -290,7 +290,9 @@ def test_preempt_then_start(page, server):
     assert page.is_disabled("#preempt-btn")
     page.wait_for_selector("#start-btn:not([disabled])")
     page.click("#start-btn")
-    page.wait_for_selector("#run-state.running")
+    page.wait_for_selector("#notice:has-text('Start ')", timeout=15000)
+    assert "Start accepted" in page.text_content("#notice"), page.text_content("#notice")
+    page.wait_for_selector("#run-state.running", timeout=15000)
     page.wait_for_selector("#graph g.node.active")
 
 

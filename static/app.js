@@ -390,6 +390,7 @@ function renderPanels() {
   log.flush();
   const udPath = userdata.path;
   userdata.update(shownStatus(), udPath ? store.nodes.get(udPath) : null);
+  log.followNewest();
 }
 
 // ---------------------------------------------------------------- go

@@ -91,6 +91,7 @@ export class EventLog {
     this.described = new WeakMap(); // event -> {line, text}: its transcript line and the text the filter searches
     this.needle = ""; // the text filter, lower case
     this.stick = true; // follow the newest row (false once the user scrolls up)
+    this.scrollDue = false; // rows were drawn while following: followNewest() scrolls to them
     host.addEventListener("scroll", () => {
       this.stick = host.scrollHeight - host.scrollTop - host.clientHeight < 24;
     }, { passive: true });
@@ -196,7 +197,15 @@ export class EventLog {
       }
     }
     this._count();
-    if (stick) this.host.scrollTop = this.host.scrollHeight;
+    this.scrollDue = stick;
+  }
+
+  /** After the frame's other writes (a flush, then the userdata): to the newest row when the log
+   * follows it. Reading the log's height lays the page out, once for all of them. */
+  followNewest() {
+    if (!this.scrollDue) return;
+    this.scrollDue = false;
+    this.host.scrollTop = this.host.scrollHeight;
   }
 
   /** Looking back: show `past` ({events, seq}, the events around the instant seq), the instant's

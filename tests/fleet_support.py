@@ -55,6 +55,17 @@ def slow_loop(steps: int, pause: float = 0.01) -> fsm.StateMachine:
     return sm
 
 
+def run_published(robot, sm: fsm.StateMachine, name: str = "loop") -> tuple[list[dict], threading.Thread]:
+    """``sm`` published by ``robot`` as ``name``, run in a thread: the events of the robot's own stream
+    (what its log has), and the thread."""
+    own: list[dict] = []
+    fsm.attach(sm, robot, name=name)
+    fsm.attach(sm, own.append)
+    runner = threading.Thread(target=sm.execute, daemon=True)
+    runner.start()
+    return own, runner
+
+
 class Proxy:
     """Forwards ``tcp/127.0.0.1:<port>`` (its ``endpoint``) to ``target`` until ``cut()``, which closes
     every connection and refuses new ones until ``restore()``."""

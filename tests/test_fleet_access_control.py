@@ -22,14 +22,13 @@ ends as "no answer" (None; the dashboard's 504) after the watcher's QUERY_TIMEOU
 from __future__ import annotations
 
 import json
-import threading
 import time
 from pathlib import Path
 from types import SimpleNamespace
 
 import fsm
 import pytest
-from fleet_support import free_endpoint, slow_loop
+from fleet_support import free_endpoint, run_published, slow_loop
 
 from fleet import control, keys
 from fleet.robot import ZenohRobot
@@ -93,11 +92,7 @@ def fleet(tmp_path):
     endpoint = free_endpoint()
     robot = ZenohRobot("r1", listen=[endpoint], token=TOKEN, config_file=robot_configuration(tmp_path))
     sm = slow_loop(100_000, 0.02)
-    own: list[dict] = []
-    fsm.attach(sm, robot, name="loop")
-    fsm.attach(sm, own.append)
-    runner = threading.Thread(target=sm.execute, daemon=True)
-    runner.start()
+    own, runner = run_published(robot, sm)
     watchers: list[FleetWatcher] = []
 
     def dashboard(user: str, password: str) -> SimpleNamespace:

@@ -4,11 +4,10 @@ answers with the event it caused; nothing without the robot's token controls its
 
 from __future__ import annotations
 
-import threading
 
 import fsm
 import pytest
-from fleet_support import free_endpoint, slow_loop
+from fleet_support import free_endpoint, run_published, slow_loop
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
@@ -26,11 +25,7 @@ def fleet():
     watcher = FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint])
     robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
     sm = slow_loop(100_000, 0.02)
-    own: list[dict] = []
-    fsm.attach(sm, robot, name="loop")
-    fsm.attach(sm, own.append)
-    runner = threading.Thread(target=sm.execute, daemon=True)
-    runner.start()
+    own, runner = run_published(robot, sm)
     wait_for(lambda: watcher.controls.get("r1:loop"), 10, what="the robot's machine joined, taking controls")
     try:
         yield watcher, robot, own

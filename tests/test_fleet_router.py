@@ -6,12 +6,11 @@ is seen gone."""
 
 from __future__ import annotations
 
-import threading
 
 import fsm
 import pytest
 import zenoh
-from fleet_support import free_endpoint, slow_loop
+from fleet_support import free_endpoint, run_published, slow_loop
 
 from fleet.config import session_config
 from fleet.robot import ZenohRobot
@@ -41,19 +40,9 @@ def behind_a_router():
         router.close()
 
 
-def run(robot: ZenohRobot, sm: fsm.StateMachine) -> tuple[list[dict], threading.Thread]:
-    """``sm`` published by ``robot`` as "loop", in a thread; the events of the robot's own stream."""
-    own: list[dict] = []
-    fsm.attach(sm, robot, name="loop")
-    fsm.attach(sm, own.append)
-    runner = threading.Thread(target=sm.execute, daemon=True)
-    runner.start()
-    return own, runner
-
-
 def test_a_dashboard_behind_a_router_gets_every_event_of_a_robot_behind_it(behind_a_router):
     watcher, robot, delivered, seen = behind_a_router
-    own, runner = run(robot, slow_loop(40))
+    own, runner = run_published(robot, slow_loop(40))
     runner.join(20)
     robot.flush()
     wait_for(lambda: delivered and delivered[-1]["seq"] == own[-1]["seq"], 10,
@@ -66,7 +55,7 @@ def test_a_dashboard_behind_a_router_gets_every_event_of_a_robot_behind_it(behin
 def test_a_control_goes_through_the_router_to_the_robot_and_its_answer_comes_back(behind_a_router):
     watcher, robot, delivered, seen = behind_a_router
     sm = slow_loop(100_000, 0.02)
-    own, runner = run(robot, sm)
+    own, runner = run_published(robot, sm)
     try:
         wait_for(lambda: watcher.controls.get("r1:loop"), 10, what="the machine joined through the router")
         answer = watcher.ask("r1", "loop", TOKEN, "preempt", {"reason": "through the router"}, "operator")
@@ -81,7 +70,7 @@ def test_a_control_goes_through_the_router_to_the_robot_and_its_answer_comes_bac
 
 def test_a_robot_behind_a_router_that_leaves_is_seen_gone(behind_a_router):
     watcher, robot, delivered, seen = behind_a_router
-    own, runner = run(robot, slow_loop(5, 0.0))
+    own, runner = run_published(robot, slow_loop(5, 0.0))
     runner.join(10)
     wait_for(lambda: ("r1:loop", True) in seen, 10, what="the machine seen through the router")
     robot.close()

@@ -8,13 +8,12 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-import threading
 import time
 
 import fsm
 import httpx
 import pytest
-from fleet_support import ROOT, Dashboard, Proxy, Robot, free_endpoint, slow_loop
+from fleet_support import ROOT, Dashboard, Proxy, Robot, free_endpoint, run_published, slow_loop
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
@@ -117,12 +116,7 @@ def running_robot(endpoint: str, token: str):
     """Robot r1 with token ``token``, its machine "loop" running until preempted: (robot, its events, thread)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     robot = ZenohRobot("r1", connect=[endpoint], token=token)
-    own: list[dict] = []
-    sm = slow_loop(100_000, 0.02)
-    fsm.attach(sm, robot, name="loop")
-    fsm.attach(sm, own.append)
-    runner = threading.Thread(target=sm.execute, daemon=True)
-    runner.start()
+    own, runner = run_published(robot, slow_loop(100_000, 0.02))
     return robot, own, runner
 
 

@@ -28,7 +28,7 @@ from types import SimpleNamespace
 
 import fsm
 import pytest
-from fleet_support import free_endpoint, run_published, slow_loop
+from fleet_support import Dashboard, free_endpoint, run_published, slow_loop
 
 from fleet import control, keys
 from fleet.robot import ZenohRobot
@@ -87,7 +87,7 @@ def dashboard_configuration(directory: Path, user: str, password: str) -> str:
 def fleet(tmp_path):
     """Robot r1 (control token TOKEN) listening with the configuration above, its machine "loop"
     ticking every 20 ms until preempted; ``dashboard(user, password)`` connects a dashboard's watcher
-    to it. Yields a namespace: robot, own (the robot's recorded events), runner, dashboard."""
+    to it. Yields a namespace: robot, its endpoint, own (the robot's recorded events), runner, dashboard."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     endpoint = free_endpoint()
     robot = ZenohRobot("r1", listen=[endpoint], token=TOKEN, config_file=robot_configuration(tmp_path))
@@ -104,7 +104,7 @@ def fleet(tmp_path):
         return SimpleNamespace(watcher=watcher, seen=seen, alive=alive)
 
     try:
-        yield SimpleNamespace(robot=robot, own=own, runner=runner, dashboard=dashboard)
+        yield SimpleNamespace(robot=robot, own=own, runner=runner, dashboard=dashboard, endpoint=endpoint)
     finally:
         sm.request_preempt()
         runner.join(10)
@@ -149,6 +149,19 @@ def test_a_viewers_control_is_never_applied_even_with_the_robots_token(fleet, mo
     assert not any(e["kind"] == "terminate" for e in list(fleet.own))
     assert controls_of(list(fleet.own)) == []
     assert fleet.robot.controls.refused == 0  # not refused by fsmscope's token check: it never got there
+
+
+def test_a_viewers_dashboard_answers_its_preempt_with_a_504_naming_the_access_control(fleet, tmp_path):
+    dash = Dashboard("--zenoh", fleet.endpoint, "--zenoh-token", "r1=" + TOKEN,
+                     "--zenoh-config", dashboard_configuration(tmp_path, "viewer", PASSWORDS["viewer"]))
+    try:
+        wait_for(lambda: dash.machines().get(NAME, {}).get("running"), 15, what="the dashboard showing the machine")
+        answer = dash.post("/api/machines/%s/preempt" % NAME, {})
+        assert answer.status_code == 504
+        assert "access control denies this dashboard's controls" in answer.json()["detail"]
+        assert dash.machines()[NAME]["running"] and controls_of(list(fleet.own)) == []
+    finally:
+        dash.stop()
 
 
 def test_zenoh_ends_a_viewers_query_on_the_control_key_at_once_without_a_reply(fleet):

@@ -133,7 +133,9 @@ class FleetLink:
             raise not_connected(machine)
         answer = self.watcher.ask(self.robot, self.machine, self.token, action, params, client)
         if answer is None:
-            raise ControlError(504, "robot %r did not answer the control of %r" % (self.robot, self.machine))
+            # Zenoh ends a query its access control denies as if nobody were there: say both.
+            raise ControlError(504, "robot %r did not answer the control of %r: it is unreachable, or its Zenoh "
+                                    "access control denies this dashboard's controls" % (self.robot, self.machine))
         return taken(machine, answer)
 
     def post(self, frame: dict) -> None:

@@ -16,7 +16,8 @@
   rest comes from its cache).
 
 The machines run in this process, served by a real uvicorn on a free port (server.http_server), as a
-user's ``IntrospectionServer`` would. Run it under the browser lock:
+user's ``IntrospectionServer`` would. The pages are ones Playwright does not follow (bench/quiet_page.py):
+it would have Chromium report it every websocket frame. Run it under the browser lock:
 
     flock /tmp/fsmscope-browser.lock .venv/bin/python bench/big_machine_browser.py [--rounds 3] [--seconds 5]
 """
@@ -33,10 +34,11 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 import fsm  # noqa: E402
+from quiet_page import QuietPage  # noqa: E402
 from server import graph  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
 from server.testing.big_machine import big_machine, count_states  # noqa: E402
-from server.testing.browser import launch_chromium, open_page  # noqa: E402
+from server.testing.browser import launch_chromium  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 RATE = 1000  # events/s the running machine is paced to
@@ -82,25 +84,25 @@ def paced_tick(shape: tuple[int, int, int]) -> float:
 
 def follow_round(browser, srv: ServerThread, seconds: float) -> tuple[float, float, float]:
     """(long-task share %, longest frame gap ms, events/s the page saw) of one fresh page, all open."""
-    page = open_page(browser, srv.url + "#m=big", 1600, 900, timeout_ms=30000)
+    page = QuietPage(browser, None, 1600, 900)
     try:
         page.add_init_script(PROBE)
-        page.reload()
+        page.goto(srv.url + "#m=big")
         page.wait_for_selector("#badge.live")
         page.wait_for_selector("#graph svg")
         deepest = page.evaluate("() => [...document.querySelectorAll('#depth option:not([hidden])')]"
                                 ".map(o => o.value).filter(v => /^\\d+$/.test(v)).pop()")
         page.select_option("#depth", deepest)
-        page.wait_for_function("() => document.querySelectorAll('#graph g.node').length >= 560", timeout=30000)
+        page.wait_for("() => document.querySelectorAll('#graph g.node').length >= 560", timeout=30)
         page.check("#follow")
-        page.wait_for_timeout(1000)
-        seq0 = page.evaluate("window.fsmscope.liveStatus.last_seq")
+        time.sleep(1)
+        seq0 = page.evaluate("() => window.fsmscope.liveStatus.last_seq")
         page.evaluate("() => { const p = window.__probe; p.long = []; p.gaps = []; p.last = null; p.watching = true; }")
         started = time.monotonic()
-        page.wait_for_timeout(seconds * 1000)
+        time.sleep(seconds)
         probe = page.evaluate("() => { const p = window.__probe; p.watching = false; return p; }")
         elapsed = time.monotonic() - started
-        seen = (page.evaluate("window.fsmscope.liveStatus.last_seq") - seq0) / elapsed
+        seen = (page.evaluate("() => window.fsmscope.liveStatus.last_seq") - seq0) / elapsed
         share = 100.0 * sum(probe["long"]) / (elapsed * 1000)
         return share, max(probe["gaps"] or [0.0]), seen
     finally:
@@ -109,15 +111,14 @@ def follow_round(browser, srv: ServerThread, seconds: float) -> tuple[float, flo
 
 def first_graph_round(browser, srv: ServerThread) -> float:
     """Milliseconds from a fresh page's navigation to the graph's SVG in it."""
-    context = browser.new_context(viewport={"width": 1600, "height": 900})
+    page = QuietPage(browser, None, 1600, 900)
     try:
-        page = context.new_page()
         page.add_init_script(PROBE)
         page.goto(srv.url + "#m=big2")
-        page.wait_for_function("() => window.__probe.svgAt !== null", timeout=30000)
-        return page.evaluate("window.__probe.svgAt")
+        page.wait_for("() => window.__probe.svgAt !== null", timeout=30)
+        return page.evaluate("() => window.__probe.svgAt")
     finally:
-        context.close()
+        page.close()
 
 
 SEARCHES = ["w", "W_1_2", "task_1_2_0", "w12003", "done", "zzz", "stopped", "T_2_1_1/W_2"]
@@ -139,8 +140,9 @@ SEARCH_PROBE = """async (queries) => {
 
 def search_round(browser, srv: ServerThread) -> float:
     """The slowest query's milliseconds in the palette of a fresh page on the 2,000-state machine."""
-    page = open_page(browser, srv.url + "#m=big2", 1600, 900, timeout_ms=30000)
+    page = QuietPage(browser, srv.url + "#m=big2", 1600, 900)
     try:
+        page.wait_for_selector("#graph svg")
         page.wait_for_selector("#badge.live")
         return max(page.evaluate(SEARCH_PROBE, SEARCHES))
     finally:
@@ -150,14 +152,15 @@ def search_round(browser, srv: ServerThread) -> float:
 def semantic_round(browser, srv: ServerThread, seconds: float) -> list[tuple[float, int, int]]:
     """(ms, containers opened or closed, containers dot laid out) of each re-layout semantic zoom asked
     for in a fresh page following the running machine for ``seconds``."""
-    page = open_page(browser, srv.url + "#m=big", 1600, 900, timeout_ms=30000)
+    page = QuietPage(browser, srv.url + "#m=big", 1600, 900)
     try:
+        page.wait_for_selector("#graph svg")
         page.wait_for_selector("#badge.live")
         page.check("#follow")
         found = []
         for _ in range(int(seconds * 10)):
             before = graph._default.layouts
-            page.wait_for_timeout(100)
+            time.sleep(0.1)
             entries = page.evaluate("""() => {
               const e = performance.getEntriesByName('fsmscope:relayout');
               performance.clearMeasures('fsmscope:relayout');

@@ -10,7 +10,9 @@ process. In rounds, each a window of ``--seconds``: no page; one Chromium page s
 one page looking back (a click on the timeline's axis into the past, then playing from there at 1x,
 again every second); and, as a control, the same page looking back at another run, served by another
 process (``fsmscope replay --serve``), which nothing links to the machine but the computer's cores. The
-rates are counted afterwards in the recording, over each window; medians of the rounds.
+rates are counted afterwards in the recording, over each window; medians of the rounds. The pages are
+ones Playwright does not follow (bench/quiet_page.py): it would have Chromium report it every websocket
+frame.
 
 On this 2-core machine the page's Chromium, the benchmark's driver and the machine's process share the
 cores: the drop includes Chromium's own CPU, the server answering the page (status at an instant,
@@ -34,13 +36,14 @@ import sys
 import tempfile
 import time
 from pathlib import Path
-from typing import Any, Callable
+from typing import Callable
 
 # The repository first: run as a script, this folder comes first and its server.py would shadow the package.
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 from demo_cpu import TICKS, cpu_seconds  # noqa: E402
+from quiet_page import QuietPage  # noqa: E402
 from server.testing.browser import launch_chromium  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 from replay import generate  # noqa: E402  (bench/replay.py: the two-state loop, recorded)
@@ -144,14 +147,14 @@ def idle_until(end: float) -> None:
     time.sleep(max(0.0, end - time.time()))
 
 
-def looking_back(page: Any, rng: random.Random) -> Callable[[float], None]:
+def looking_back(page: QuietPage, rng: random.Random) -> Callable[[float], None]:
     """Every second: a click on the timeline's axis at a random point of the run's first 80 %, then play."""
     def drive(end: float) -> None:
         while time.time() < end:
             x0, x1, y = axis(page)
-            page.mouse.click(x0 + rng.uniform(0.05, 0.8) * (x1 - x0), y)
-            page.wait_for_function("() => window.fsmscope.instant.past")
-            page.keyboard.press("Space")
+            page.click(x0 + rng.uniform(0.05, 0.8) * (x1 - x0), y)
+            page.wait_for("() => window.fsmscope.instant.past")
+            page.press("Space")
             idle_until(min(end, time.time() + 1.0))
         if not page.evaluate("() => window.fsmscope.instant.past"):
             raise RuntimeError("the page went back to live while looking back")

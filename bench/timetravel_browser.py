@@ -15,7 +15,9 @@
 A probe in the page wraps requestAnimationFrame: the app's callback named ``render`` is timed, and a
 message it posts marks the end of its frame (a posted message runs once style, layout and paint are
 done). The logs are written by the real Recorder (bench/replay.py's ``generate`` for the two-state
-loop); ``--logs DIR`` keeps them there and reuses them. Run it under the browser lock:
+loop); ``--logs DIR`` keeps them there and reuses them. The pages are ones Playwright does not follow
+(bench/quiet_page.py): it would have Chromium report it every request and websocket frame. Run it
+under the browser lock:
 
     flock /tmp/fsmscope-browser.lock .venv/bin/python bench/timetravel_browser.py [--logs DIR]
 """
@@ -41,8 +43,9 @@ sys.path.insert(0, ROOT)
 
 import fsm  # noqa: E402
 from fsm.logfiles.recorder import Recorder  # noqa: E402
+from quiet_page import QuietPage  # noqa: E402
 from replay import generate  # noqa: E402  (bench/replay.py: the two-state loop, recorded)
-from server.testing.browser import launch_chromium, open_page  # noqa: E402
+from server.testing.browser import launch_chromium  # noqa: E402
 from server.testing.demo_process import FSMSCOPE  # noqa: E402
 from server.testing.polling import wait_for  # noqa: E402
 from table import print_table, verdict  # noqa: E402
@@ -124,7 +127,7 @@ def served(arguments: list[str], says: str) -> Iterator[tuple[str, subprocess.Po
 
 
 @contextlib.contextmanager
-def dashboard(log: str) -> Iterator[Any]:
+def dashboard(log: str) -> Iterator[QuietPage]:
     """A Chromium page showing the replay of ``log``, paused at its start, the probe installed."""
     from playwright.sync_api import sync_playwright
 
@@ -132,7 +135,7 @@ def dashboard(log: str) -> Iterator[Any]:
         browser = launch_chromium(pw)
         try:
             with page_of(browser, url) as page:
-                page.wait_for_function("() => window.fsmscope.instant.seq !== null")
+                page.wait_for("() => window.fsmscope.instant.seq !== null")
                 page.evaluate(PROBE)
                 yield page
         finally:
@@ -140,11 +143,12 @@ def dashboard(log: str) -> Iterator[Any]:
 
 
 @contextlib.contextmanager
-def page_of(browser: Any, url: str) -> Iterator[Any]:
-    """A new page of ``browser`` showing the dashboard at ``url`` with its timeline; closed after, and
-    failing if the page met an uncaught error."""
-    page = open_page(browser, url, timeout_ms=60000)
+def page_of(browser: Any, url: str) -> Iterator[QuietPage]:
+    """A new page of ``browser`` showing the dashboard at ``url`` with its graph and timeline; closed after,
+    and failing if the page met an uncaught error."""
+    page = QuietPage(browser, url)
     try:
+        page.wait_for_selector("#graph svg")
         page.wait_for_selector("#timeline canvas")
         yield page
         if page.errors:
@@ -153,14 +157,14 @@ def page_of(browser: Any, url: str) -> Iterator[Any]:
         page.close()
 
 
-def axis(page: Any) -> tuple[float, float, float]:
+def axis(page: QuietPage) -> tuple[float, float, float]:
     """(x of the run's start, x of its end, y) on the timeline's time axis, in page pixels."""
     layout = page.evaluate("async () => (await import('/timeline_draw.js')).LAYOUT")
-    box = page.locator("#timeline canvas").bounding_box()
+    box = page.bounding_box("#timeline canvas")
     return box["x"] + layout["labelW"] + 1, box["x"] + box["width"] - layout["padR"] - 1, box["y"] + layout["axisH"] / 2
 
 
-def seek_randomly(page: Any, rng: random.Random) -> dict:
+def seek_randomly(page: QuietPage, rng: random.Random) -> dict:
     """Click random points of the time axis until one shows another instant: the click's time (``input``),
     the probe's record of the render that showed the instant (``shown``) and of the next one, which adds
     the event log's window around it (``log``, or None)."""
@@ -168,8 +172,8 @@ def seek_randomly(page: Any, rng: random.Random) -> dict:
     while True:
         before = page.evaluate("() => window.fsmscope.instant.seq")
         page.evaluate("() => { window.__probe.renders = []; window.__probe.input = null; }")
-        page.mouse.click(rng.uniform(x0, x1), y)
-        page.wait_for_function(AFTER_CLICK)
+        page.click(rng.uniform(x0, x1), y)
+        page.wait_for(AFTER_CLICK)
         time.sleep(SETTLE)
         renders = page.evaluate(AFTER_CLICK)
         if renders[0]["seq"] != before:
@@ -201,9 +205,10 @@ def seek_rows(log: str, rng: random.Random) -> list[tuple[str, str, str, str]]:
 
 def repaint_rows(log: str, rng: random.Random) -> list[tuple[str, str, str, str]]:
     with dashboard(log) as page:
-        deepest = page.eval_on_selector("#depth", "s => [...s.options].filter((o) => !o.hidden).pop().value")
+        deepest = page.evaluate("() => [...document.querySelector('#depth').options].filter((o) => !o.hidden)"
+                                ".pop().value")
         page.select_option("#depth", deepest)
-        page.wait_for_function("() => (%s)() >= 600" % DRAWN)
+        page.wait_for("() => (%s)() >= 600" % DRAWN)
         drawn = page.evaluate(DRAWN)
         seek_randomly(page, rng)
         seeks = [seek_randomly(page, rng) for _ in range(REPAINTS)]
@@ -221,14 +226,14 @@ def repaint_rows(log: str, rng: random.Random) -> list[tuple[str, str, str, str]
 def drag_row(log: str) -> tuple[str, str, str, str]:
     with dashboard(log) as page:
         x0, x1, y = axis(page)
-        page.mouse.move(x0, y)
-        page.mouse.down()
+        page.mouse_move(x0, y)
+        page.mouse_down()
         page.evaluate("() => window.__probe.count()")
         end, forward = time.monotonic() + DRAG_SECONDS, True
         while time.monotonic() < end:
-            page.mouse.move(x1 if forward else x0, y, steps=DRAG_STEPS)
+            page.mouse_move(x1 if forward else x0, y, steps=DRAG_STEPS)
             forward = not forward
-        page.mouse.up()
+        page.mouse_up()
         drag = page.evaluate("() => window.__probe.stop()")
     rate = drag["frames"] / drag["seconds"]
     return ("drag the playhead over a 100,000-event run for %.0f s" % DRAG_SECONDS, ">= 30 frames/s",

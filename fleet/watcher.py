@@ -28,6 +28,7 @@ sends a control to the machine's robot (fleet/control.py). The watcher's livelin
 
 from __future__ import annotations
 
+import sys
 import threading
 from typing import Callable, Sequence
 
@@ -71,6 +72,7 @@ class FleetWatcher:
         self.gaps_filled = 0
         self.snapshots = 0
         self.backfilled = 0  # machines taken from their first event
+        self.rejected = 0  # samples that were not what a robot puts
         self.id = str(self.session.zid())
         self._presence = self.session.liveliness().declare_token(keys.dashboard_key(self.id))
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
@@ -108,15 +110,28 @@ class FleetWatcher:
         channel = subscriber.handler  # not the subscriber itself: one borrowed by a wait cannot be undeclared
         try:
             while True:
-                handle(channel.recv())
+                self._handle(handle, channel.recv())
                 for _ in range(BURST - 1):
                     sample = channel.try_recv()
                     if sample is None:
                         break
-                    handle(sample)
+                    self._handle(handle, sample)
                 self.settled()
         except zenoh.ZError:  # the session closed
             pass
+
+    def _handle(self, handle: Callable[[zenoh.Sample], None], sample: zenoh.Sample) -> None:
+        """One sample; one that is not what a robot puts (anyone on the network can put on these keys)
+        is counted and said, and the reader goes on with the next."""
+        try:
+            handle(sample)
+        except zenoh.ZError:
+            raise
+        except Exception as exc:
+            self.rejected += 1
+            if self.rejected & (self.rejected - 1) == 0:  # the 1st, 2nd, 4th, 8th...: a flood says little
+                print("fsmscope: a sample on %s is not a robot's (%s: %s); %d so far" % (
+                    sample.key_expr, type(exc).__name__, str(exc)[:200], self.rejected), file=sys.stderr, flush=True)
 
     # The readers' threads.
     def _on_token(self, sample: zenoh.Sample) -> None:

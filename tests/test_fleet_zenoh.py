@@ -10,9 +10,11 @@ import time
 
 import fsm
 import pytest
-from fleet_support import Proxy, free_endpoint, slow_loop
+import zenoh
+from fleet_support import Proxy, free_endpoint, run_published, slow_loop
 
 import fleet.robot
+from fleet.config import session_config
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from fsm.control.handle import MachineHandle
@@ -219,6 +221,30 @@ def test_two_dashboards_watch_the_same_robot_and_each_gets_every_event(quiet):
         robot.close()
         for dash in dashes:
             dash.watcher.close()
+
+
+def test_a_put_that_is_not_a_robots_is_counted_and_the_watcher_follows_on(quiet):
+    endpoint = free_endpoint()
+    dash = Dashboard(listen=[endpoint])
+    robot = ZenohRobot("r1", connect=[endpoint])
+    stranger = zenoh.open(session_config(connect=[endpoint]))
+    sm = slow_loop(100_000, 0.02)
+    own, runner = run_published(robot, sm)
+    try:
+        wait_for(lambda: len(dash.events) >= 5, 10, what="the machine followed")
+        for payload in (b"not json", b'{"seq": 1}', b'[{"no": "seq"}]'):
+            stranger.put("fsmscope/r1/loop/events", payload)
+        wait_for(lambda: dash.watcher.rejected == 3, 10, what="the three puts rejected")
+        count = len(dash.events)
+        wait_for(lambda: len(dash.events) >= count + 10, 10, what="the machine still followed")
+    finally:
+        sm.request_preempt()
+        runner.join(10)
+        robot.close()
+        stranger.close()
+        dash.watcher.close()
+    robot_seqs = [event["seq"] for event in own]
+    assert [event["seq"] for event in dash.events] == robot_seqs[:len(dash.events)]
 
 
 def test_a_closed_robot_keeps_no_more_than_a_batch_of_what_its_machine_still_does(quiet):

@@ -206,7 +206,7 @@ async function loadGraph(semantic = false) {
   const expand = depth.paths();
   const key = JSON.stringify([name, store.structureKey, expand]);
   try {
-    const anchor = semantic ? store.selected || graph.activePath : null;
+    const anchor = semantic ? () => store.selected || graph.activePath : null;
     if (await graph.load(key, () => api.graphSvg(name, expand), anchor)) {
       depth.laidOut();
       queueRender();

@@ -59,16 +59,18 @@ export class GraphView {
 
   /**
    * Load the layout for `key` (a string naming structure + expand set) unless already shown.
-   * @param {string|null} anchorPath keep this state (or its closest drawn ancestor) where it is on
-   *   screen, at the same scale; null: fit the new drawing
+   * @param {(() => string|null)|null} anchorOf the state to keep (or its closest drawn ancestor) where
+   *   it is on screen, at the same scale, asked when the drawing has come (the user may have selected
+   *   another meanwhile); null: fit the new drawing
    */
-  async load(key, fetchSvg, anchorPath = null) {
+  async load(key, fetchSvg, anchorOf = null) {
     const token = ++this.loadToken; // any later request, even for the drawing shown, outdates one in flight
     if (key === this.key) return false;
     const text = await fetchSvg();
     if (token !== this.loadToken) return false; // a newer load started meanwhile
     const svg = parseSvg(text);
-    const anchor = anchorPath && this.svg ? anchorBefore(this, anchorPath) : null;
+    const anchorPath = anchorOf && this.svg ? anchorOf() : null;
+    const anchor = anchorPath ? anchorBefore(this, anchorPath) : null;
     const vb = svg.viewBox.baseVal;
     let base;
     if (vb && vb.width > 0) {

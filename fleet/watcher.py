@@ -16,10 +16,15 @@ again (from its first event, or a snapshot) when the process is a new one (its s
 Each delivered event carries the dashboard's name of the machine, ``<robot>:<machine>``: machines
 of different robots may share a name. Two threads of the watcher's read Zenoh's channels (bounded:
 the events' drops its oldest batch when full, and the gap is filled from history after) and handle
-what they read one at a time, under one lock: deliver, ask the queries. A thread asking a query
-leaves its channel to fill meanwhile; no other hop is taken per batch (each costs a fleet's
-dashboard more than the batch's events do). A reader handles what its channel holds before it says
-``settled``: the robots put on the same tick, and the dashboard's loop is woken once for them.
+what they read one at a time, under one lock. The events' reader delivers, and asks a robot it
+follows for a gap; no other hop is taken per batch (each costs a fleet's dashboard more than the
+batch's events do). A reader handles what its channel holds before it says ``settled``: the robots
+put on the same tick, and the dashboard's loop is woken once for them. A third thread joins the
+machines, asking their state and history without the lock: a machine that answers slowly, or a
+stranger's token that nobody answers for, never holds up the events of the others. Events of a
+machine whose token was never seen are skipped (anyone on the network can put on these keys: asking
+for each would let one put a second stop the dashboard for five); those of a machine alive but not
+joined yet ask its join again, at most once per ``JOIN_AGAIN``.
 
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
 sends a control to the machine's robot (fleet/control.py). The watcher's liveliness token
@@ -28,9 +33,11 @@ sends a control to the machine's robot (fleet/control.py). The watcher's livelin
 
 from __future__ import annotations
 
+import queue
 import sys
 import threading
-from typing import Callable, Sequence
+from time import monotonic
+from typing import Any, Callable, Sequence
 
 import zenoh
 
@@ -44,6 +51,7 @@ from .query import first_reply
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
 QUEUE = 10_000  # samples waiting in a channel for the watcher's thread before the oldest are dropped
 BURST = 64  # samples handled at most before ``settled`` is called, when they keep coming
+JOIN_AGAIN = 1.0  # seconds before the events of a machine alive but not joined ask its join again
 
 
 def fleet_name(robot: str, machine: str) -> str:
@@ -68,11 +76,15 @@ class FleetWatcher:
         self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
         self.controls: dict[str, dict | None] = {}  # machine -> what its robot said of its controls
         self._origins: dict[str, str] = {}  # machine -> the session id of the robot's process
-        self._lock = threading.Lock()  # one sample handled at a time, by either reader
+        self._lock = threading.Lock()  # one sample or join applied at a time, by any of the threads
+        self._alive: set[str] = set()  # machines whose liveliness token is up
+        self._asked: dict[str, float] = {}  # machine -> when its join was last asked for
+        self._joins: queue.SimpleQueue[str | None] = queue.SimpleQueue()  # machine keys to join; None: stop
         self.gaps_filled = 0
         self.snapshots = 0
         self.backfilled = 0  # machines taken from their first event
-        self.rejected = 0  # samples that were not what a robot puts
+        self.rejected = 0  # samples (and answers) that were not what a robot puts or answers
+        self.unannounced = 0  # event samples skipped: their machine's token was never seen
         self.id = str(self.session.zid())
         self._presence = self.session.liveliness().declare_token(keys.dashboard_key(self.id))
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
@@ -84,12 +96,14 @@ class FleetWatcher:
                                        ("tokens", self._tokens, self._on_token)):
             threading.Thread(target=self._read, args=(subscriber, read), name="fsmscope-fleet-" + name,
                              daemon=True).start()
+        threading.Thread(target=self._join_all, name="fsmscope-fleet-joins", daemon=True).start()
         closing.close_at_exit(self)
 
     def close(self) -> None:
         if self._closed:
             return
         self._closed = True
+        self._joins.put(None)
         self._presence.undeclare()
         self._tokens.undeclare()
         self._events.undeclare()
@@ -120,35 +134,56 @@ class FleetWatcher:
         except zenoh.ZError:  # the session closed
             pass
 
-    def _handle(self, handle: Callable[[zenoh.Sample], None], sample: zenoh.Sample) -> None:
-        """One sample; one that is not what a robot puts (anyone on the network can put on these keys)
-        is counted and said, and the reader goes on with the next."""
+    def _join_all(self) -> None:
+        """The joins' thread: each machine key asked for, joined (its queries wait without the lock)."""
         try:
-            handle(sample)
+            while (key := self._joins.get()) is not None:
+                self._handle(self._join, key)
+                self.settled()
+        except zenoh.ZError:  # the session closed
+            pass
+
+    def _handle(self, handle: Callable[[Any], None], item: Any) -> None:
+        """One sample (or a machine to join); what is not what a robot puts or answers (anyone on the
+        network can put on these keys) is counted and said, and the thread goes on with the next."""
+        try:
+            handle(item)
         except zenoh.ZError:
             raise
         except Exception as exc:
             self.rejected += 1
             if self.rejected & (self.rejected - 1) == 0:  # the 1st, 2nd, 4th, 8th...: a flood says little
-                print("fsmscope: a sample on %s is not a robot's (%s: %s); %d so far" % (
-                    sample.key_expr, type(exc).__name__, str(exc)[:200], self.rejected), file=sys.stderr, flush=True)
+                print("fsmscope: what came on %s is not a robot's (%s: %s); %d so far" % (
+                    getattr(item, "key_expr", item), type(exc).__name__, str(exc)[:200], self.rejected),
+                    file=sys.stderr, flush=True)
+
+    def _ask_join(self, name: str, key: str) -> None:
+        """Under the lock: have the joins' thread join the machine."""
+        self._asked[name] = monotonic()
+        self._joins.put(key)
 
     # The readers' threads.
     def _on_token(self, sample: zenoh.Sample) -> None:
-        robot, machine = keys.split(str(sample.key_expr))
-        name = fleet_name(robot, machine)
+        key = str(sample.key_expr)
+        name = fleet_name(*keys.split(key))
         up = sample.kind == zenoh.SampleKind.PUT
         with self._lock:
             self.alive(name, up)
             if up:
-                self._join(robot, machine)
+                self._alive.add(name)
+                self._ask_join(name, key)
+            else:
+                self._alive.discard(name)
 
     def _on_events(self, sample: zenoh.Sample) -> None:
         robot, machine = keys.split(str(sample.key_expr))
         name = fleet_name(robot, machine)
         with self._lock:
-            if name not in self._last:  # not joined: its state did not answer yet (Zenoh had not told it)
-                self._snapshot(robot, machine)
+            if name not in self._last:  # not joined (yet: its token came, its join is on its way)
+                if name not in self._alive:
+                    self.unannounced += 1
+                elif monotonic() - self._asked.get(name, 0.0) >= JOIN_AGAIN:  # its state did not answer
+                    self._ask_join(name, keys.machine_key(robot, machine))
                 return
             events = loads(sample.payload.to_bytes())
             if events and events[0]["seq"] > self._last[name] + 1:
@@ -170,55 +205,65 @@ class FleetWatcher:
         answer = first_reply(self.session, keys.state_key(robot, machine), QUERY_TIMEOUT)
         return None if answer is None else loads(answer)
 
-    def _join(self, robot: str, machine: str) -> None:
-        """A machine seen alive: new, or back after a drop (what it missed), or from a new process."""
+    def _history(self, robot: str, machine: str, since: int) -> dict | None:
+        """The robot's answer of the machine's events from ``since`` on; None when none came."""
+        reply = first_reply(self.session, keys.history_key(robot, machine) + "?since=%d" % since, QUERY_TIMEOUT)
+        return None if reply is None else loads(reply)
+
+    def _join(self, key: str) -> None:
+        """In the joins' thread, the queries without the lock: a machine seen alive, new, or back after a
+        drop (what it missed), or from a new process (taken again)."""
+        robot, machine = keys.split(key)
         name = fleet_name(robot, machine)
         answer = self._state(robot, machine)
         if answer is None:
-            return
-        if name in self._last and answer["origin"] == self._origins.get(name):
-            self._fill(robot, machine, self._last[name] + 1)
-        else:
-            self._take(robot, machine, answer)
+            return  # its next events ask again
+        with self._lock:
+            back = name in self._last and answer["origin"] == self._origins.get(name)
+            since = self._last[name] + 1 if back else 1
+        history = self._history(robot, machine, since)
+        with self._lock:
+            if back:
+                self._filled(name, history, lambda: answer)
+            else:
+                self._take(name, answer, history)
 
-    def _snapshot(self, robot: str, machine: str) -> None:
-        answer = self._state(robot, machine)
-        if answer is not None:
-            self._take(robot, machine, answer)
-
-    def _take(self, robot: str, machine: str, answer: dict) -> None:
+    def _take(self, name: str, answer: dict, history: dict | None) -> None:
         """A machine new to this watcher (or its robot's process is): every event from its first when
-        the robot still keeps them all (a dashboard restarted, or late, can look back over the whole
-        run), else the state answer's snapshot, from which its events go on."""
-        name = fleet_name(robot, machine)
+        the robot still keeps them all (``history`` from 1: a dashboard restarted, or late, can look
+        back over the whole run), else the state answer's snapshot, from which its events go on."""
+        same = answer["origin"] == self._origins.get(name)
         self.controls[name] = answer.get("controls")
         self._origins[name] = answer["origin"]
-        self._last.pop(name, None)
-        reply = first_reply(self.session, keys.history_key(robot, machine) + "?since=1", QUERY_TIMEOUT)
-        history = None if reply is None else loads(reply)
         if history is not None and history["complete"] and history["events"]:
+            self._last.pop(name, None)
             self._deliver(name, history["events"])
             self.backfilled += 1
             return
         snapshot = answer["snapshot"]
+        if same and self._last.get(name, 0) >= snapshot["seq"]:
+            return  # its events came on past this snapshot while it was asked for
         snapshot["machine"] = name
         snapshot["status"]["machine"] = name
         self.deliver([snapshot])
         self._last[name] = snapshot["seq"]
         self.snapshots += 1
 
+    def _filled(self, name: str, history: dict | None, answer_of: Callable[[], dict | None]) -> None:
+        """A gap's events from the robot's ``history``; the snapshot of its state answer (``answer_of``)
+        when it no longer has them."""
+        if history is None:
+            return
+        if history["complete"]:
+            self._deliver(name, history["events"])
+            self.gaps_filled += 1
+        elif (answer := answer_of()) is not None:
+            self._take(name, answer, None)
+
     def _fill(self, robot: str, machine: str, since: int) -> None:
-        """The events from ``since`` on, from the robot's history; a snapshot when it no longer has them."""
-        name = fleet_name(robot, machine)
-        reply = first_reply(self.session, keys.history_key(robot, machine) + "?since=%d" % since, QUERY_TIMEOUT)
-        if reply is None:
-            return
-        answer = loads(reply)
-        if not answer["complete"]:
-            self._snapshot(robot, machine)
-            return
-        self._deliver(name, answer["events"])
-        self.gaps_filled += 1
+        """In the events' reader, under the lock: the events from ``since`` on of a machine it follows."""
+        self._filled(fleet_name(robot, machine), self._history(robot, machine, since),
+                     lambda: self._state(robot, machine))
 
     def ask(self, robot: str, machine: str, token: str, action: str, params: dict, client: str) -> dict | None:
         """A control for ``robot``'s ``machine``: its robot's answer, None when none came in time."""

@@ -223,7 +223,10 @@ def test_two_dashboards_watch_the_same_robot_and_each_gets_every_event(quiet):
             dash.watcher.close()
 
 
-def test_a_put_that_is_not_a_robots_is_counted_and_the_watcher_follows_on(quiet):
+@pytest.fixture
+def followed(quiet):
+    """A dashboard following r1's machine (50 events/s), a stranger's session on its network, and what
+    the machine's observer was given (the robot's own events)."""
     endpoint = free_endpoint()
     dash = Dashboard(listen=[endpoint])
     robot = ZenohRobot("r1", connect=[endpoint])
@@ -232,19 +235,51 @@ def test_a_put_that_is_not_a_robots_is_counted_and_the_watcher_follows_on(quiet)
     own, runner = run_published(robot, sm)
     try:
         wait_for(lambda: len(dash.events) >= 5, 10, what="the machine followed")
-        for payload in (b"not json", b'{"seq": 1}', b'[{"no": "seq"}]'):
-            stranger.put("fsmscope/r1/loop/events", payload)
-        wait_for(lambda: dash.watcher.rejected == 3, 10, what="the three puts rejected")
-        count = len(dash.events)
-        wait_for(lambda: len(dash.events) >= count + 10, 10, what="the machine still followed")
+        yield dash, stranger, own
     finally:
         sm.request_preempt()
         runner.join(10)
         robot.close()
         stranger.close()
         dash.watcher.close()
+
+
+def still_followed(dash: Dashboard) -> None:
+    """The machine's next 10 events come within 2.5 s: no query of a robot that is not there (each
+    waits 5 s for an answer) held the dashboard up."""
+    count = len(dash.events)
+    wait_for(lambda: len(dash.events) >= count + 10, 2.5, what="the machine still followed")
+
+
+def test_a_put_that_is_not_a_robots_is_counted_and_the_watcher_follows_on(followed):
+    dash, stranger, own = followed
+    for payload in (b"not json", b'{"seq": 1}', b'[{"no": "seq"}]'):
+        stranger.put("fsmscope/r1/loop/events", payload)
+    wait_for(lambda: dash.watcher.rejected == 3, 10, what="the three puts rejected")
+    still_followed(dash)
     robot_seqs = [event["seq"] for event in own]
     assert [event["seq"] for event in dash.events] == robot_seqs[:len(dash.events)]
+
+
+def test_events_put_for_a_machine_that_never_announced_itself_are_skipped_at_once(followed):
+    dash, stranger, _ = followed
+    stranger.put("fsmscope/ghost/m/events", b'[{"seq": 7}]')
+    still_followed(dash)
+    assert dash.watcher.unannounced == 1
+    assert not any(event["machine"] == "ghost:m" for event in dash.events)
+
+
+def test_a_token_that_no_robot_answers_for_holds_up_no_other_machine(followed):
+    dash, stranger, _ = followed
+    token = stranger.liveliness().declare_token("fsmscope/ghost/m")
+    try:
+        wait_for(lambda: ("ghost:m", True) in dash.alive, 10, what="the stranger's token seen")
+        still_followed(dash)
+        stranger.put("fsmscope/ghost/m/events", b'[{"seq": 7}]')  # alive, not joined: asks its join again
+        still_followed(dash)
+    finally:
+        token.undeclare()
+    assert not any(event["machine"] == "ghost:m" for event in dash.events)
 
 
 def test_a_closed_robot_keeps_no_more_than_a_batch_of_what_its_machine_still_does(quiet):

@@ -48,7 +48,7 @@ from fsm.observation.encoding import dumps, encoded
 from fsm.observation.status import Status
 
 from . import keys
-from .config import session_config
+from .config import open_session
 from .control import RobotControls
 
 RING = 10_000  # events of each machine kept (as the batches put) for history queries
@@ -174,7 +174,7 @@ class ZenohRobot:
                  config_file: str | None = None) -> None:
         self.robot = keys.chunk(robot, "robot")
         self.can_start = can_start
-        self.session = zenoh.open(session_config(connect, listen, mode, scouting, config_file))
+        self.session = open_session(connect, listen, mode, scouting, config_file)
         self.controls = RobotControls(token, self.flush)
         self._stop = threading.Event()
         self._wake = threading.Event()  # a batch began: the flusher puts it if its machine goes quiet

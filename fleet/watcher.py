@@ -45,7 +45,7 @@ from fsm.observation import closing
 from fsm.observation.encoding import loads
 
 from . import control, keys
-from .config import session_config
+from .config import open_session
 from .query import first_reply
 
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
@@ -72,7 +72,7 @@ class FleetWatcher:
         self.deliver = deliver
         self.alive = alive
         self.settled = settled
-        self.session = zenoh.open(session_config(connect, listen, mode, scouting, config_file))
+        self.session = open_session(connect, listen, mode, scouting, config_file)
         self._last: dict[str, int] = {}  # machine -> the seq of the last event delivered
         self.controls: dict[str, dict | None] = {}  # machine -> what its robot said of its controls
         self._origins: dict[str, str] = {}  # machine -> the session id of the robot's process

@@ -1,7 +1,7 @@
 """Fleet tests' pieces: a free loopback tcp endpoint for Zenoh, a slow loop machine, a TCP proxy
 whose connections can be cut and let through again (a network drop between a robot and a dashboard),
-and real processes: a dashboard (``fsmscope serve --zenoh``) and robots (``fsmscope run
-robots/patrol.py --zenoh ROBOT``)."""
+and real processes: a dashboard (``fsmscope serve --zenoh``), robots (``fsmscope run
+robots/patrol.py --zenoh ROBOT``) and routers (``fsmscope router``)."""
 
 from __future__ import annotations
 
@@ -133,22 +133,36 @@ class Proxy:
         self.server.close()
 
 
-class Dashboard:
-    """``fsmscope serve --zenoh`` in a real process, listening on a Zenoh endpoint of its own."""
+def started(command: list[str], said: str) -> tuple[subprocess.Popen, re.Match]:
+    """``fsmscope COMMAND`` in a real process of its own group, once its stderr has said ``said`` (a
+    pattern): the process and the match. Its stderr is read on after, so it never blocks on a full pipe."""
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", *command], cwd=ROOT, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    for line in proc.stderr:
+        found = re.search(said, line)
+        if found:
+            threading.Thread(target=proc.stderr.read, daemon=True).start()
+            return proc, found
+    raise RuntimeError("fsmscope %s ended before it said %r" % (command[0], said))
 
-    def __init__(self, *options: str) -> None:
+
+def stop(proc: subprocess.Popen) -> None:
+    """SIGTERM to its group (a SIGINT is ignored by a process started in the background), and wait."""
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGTERM)
+    proc.wait(20)
+
+
+class Dashboard:
+    """``fsmscope serve --zenoh`` in a real process, listening on a Zenoh endpoint of its own
+    (``listen``), or only connecting where its options say (a router's client)."""
+
+    def __init__(self, *options: str, listen: bool = True) -> None:
         self.endpoint = free_endpoint()
-        self.proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
-                                      "--zenoh-listen", self.endpoint, *options], cwd=ROOT, stderr=subprocess.PIPE,
-                                     text=True, start_new_session=True)
-        for line in self.proc.stderr:
-            found = re.search(r"serving the dashboard at (http://\S+)", line)
-            if found:
-                break
-        else:
-            raise RuntimeError("the dashboard ended before serving")
+        own = ["--zenoh-listen", self.endpoint] if listen else []
+        self.proc, found = started(["serve", "--port", "0", "--zenoh", *own, *options],
+                                   r"serving the dashboard at (http://\S+)")
         self.base, self.token = found.group(1).split("/?token=")
-        threading.Thread(target=self.proc.stderr.read, daemon=True).start()  # never blocks on a full pipe
 
     def machines(self) -> dict[str, dict]:
         return {m["name"]: m for m in httpx.get(self.base + "/api/machines", params={"token": self.token}).json()}
@@ -157,24 +171,37 @@ class Dashboard:
         return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
 
     def stop(self) -> None:
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGTERM)  # a SIGINT is ignored by a process started in the background
-        self.proc.wait(20)
+        stop(self.proc)
+
+
+class Router:
+    """``fsmscope router`` in a real process, listening on ``endpoint`` (None: a free one); ``options``:
+    its others (``--connect`` another site's router)."""
+
+    def __init__(self, *options: str, endpoint: str | None = None) -> None:
+        self.endpoint = endpoint or free_endpoint()
+        self.proc, _ = started(["router", "--listen", self.endpoint, *options], r"routing Zenoh on")
+
+    def stop(self) -> None:
+        stop(self.proc)
 
 
 class Robot:
     """Robot ``name`` in a real process: ``fsmscope run robots/patrol.py --no-serve --zenoh NAME``,
-    connecting to ``endpoint`` and recording to ``log``; ``fail``: its patrol fails on the third scan."""
+    connecting to ``endpoint`` and recording to ``log``; ``fail``: its patrol fails on the third scan;
+    ``options``: more of ``run``'s (``--zenoh-mode client``, behind a router)."""
 
-    def __init__(self, name: str, endpoint: str, token: str, log: Path, fail: bool = False) -> None:
+    def __init__(self, name: str, endpoint: str, token: str, log: Path, fail: bool = False,
+                 options: tuple[str, ...] = ()) -> None:
         self.name, self.endpoint, self.token, self.log, self.fail = name, endpoint, token, log, fail
+        self.options = options
         self.proc: subprocess.Popen | None = None
         self.start()
 
     def start(self) -> None:
         self.proc = subprocess.Popen(
             [sys.executable, "-m", "server.cli", "run", str(PATROL), "--no-serve", "--record", str(self.log),
-             "--zenoh", self.name, "--zenoh-connect", self.endpoint, "--zenoh-token", self.token,
+             "--zenoh", self.name, "--zenoh-connect", self.endpoint, "--zenoh-token", self.token, *self.options,
              *(["--", "fail"] if self.fail else [])],
             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
 
@@ -199,3 +226,26 @@ class Robot:
         """Wait for its script to end; its exit code."""
         wait_for(lambda: self.proc.poll() is not None, timeout, what="robot %s's script to end" % self.name)
         return self.proc.returncode
+
+
+def history(dash: Dashboard, name: str, since: int) -> list[dict]:
+    """The dashboard's events of machine ``name`` from seq ``since`` on."""
+    events: list[dict] = []
+    while since is not None:
+        page = httpx.get(dash.base + "/api/machines/%s/history" % name,
+                         params={"token": dash.token, "since": since, "limit": 1000}).json()
+        events += page["events"]
+        since = page["next"] if page["more"] else None
+    return events
+
+
+def preempted_the_dashboard_has_the_robots_log(dash: Dashboard, robot: Robot, since: int) -> None:
+    """Preempt r1:patrol from ``dash``: its run ends, and the dashboard's events from ``since`` on are
+    those of the robot's own log."""
+    answer = dash.post("/api/machines/r1:patrol/preempt", {})
+    assert answer.status_code == 202, answer.text
+    assert robot.ended() == 0
+    own = [e for e in robot.events() if e["seq"] >= since]
+    wait_for(lambda: dash.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
+    seen = history(dash, "r1:patrol", since)
+    assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[-3:], own[-3:])

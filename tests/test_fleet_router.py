@@ -2,7 +2,8 @@
 dashboard are clients of a Zenoh session in router mode on the loopback, the routing zenohd runs
 (zenohd itself is not a Python package). Everything goes through the router: the machine is found,
 every event arrives, a control reaches the robot and its answer comes back, and a robot that leaves
-is seen gone."""
+is seen gone. Then the README's set-up in real processes, with ``fsmscope router``: one site's
+router, and two sites' routers linked."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ from __future__ import annotations
 import fsm
 import pytest
 import zenoh
-from fleet_support import free_endpoint, run_published, slow_loop
+from fleet_support import (Dashboard, Robot, Router, free_endpoint, preempted_the_dashboard_has_the_robots_log,
+                           run_published, slow_loop)
 
 from fleet.config import session_config
 from fleet.robot import ZenohRobot
@@ -75,3 +77,41 @@ def test_a_robot_behind_a_router_that_leaves_is_seen_gone(behind_a_router):
     wait_for(lambda: ("r1:loop", True) in seen, 10, what="the machine seen through the router")
     robot.close()
     wait_for(lambda: seen[-1] == ("r1:loop", False), 10, what=lambda: "the machine seen gone: %r" % seen)
+
+
+@pytest.fixture
+def processes():
+    """Stops, after the test, the real processes the test started (given to it)."""
+    started: list = []
+    yield started.append
+    for proc in reversed(started):
+        proc.stop()
+
+
+@pytest.mark.parametrize("sites", [1, 2], ids=["one router", "two sites' routers linked"])
+def test_a_dashboard_behind_fsmscope_routers_shows_a_robots_whole_run_and_preempts_it(tmp_path, processes, sites):
+    routers = [Router()]
+    processes(routers[0])
+    if sites == 2:
+        routers.append(Router("--connect", routers[0].endpoint))  # the dashboard's site joins the robot's
+        processes(routers[1])
+    robot = Robot("r1", routers[0].endpoint, TOKEN, tmp_path / "r1.jsonl")
+    processes(robot)
+    dash = Dashboard(routers[-1].endpoint, "--zenoh-mode", "client", "--zenoh-token", TOKEN, listen=False)
+    processes(dash)
+    wait_for(lambda: dash.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol running")
+    preempted_the_dashboard_has_the_robots_log(dash, robot, 1)
+
+
+def test_a_robot_started_while_its_router_is_down_runs_and_its_whole_run_reaches_the_dashboard_later(
+        tmp_path, processes):
+    endpoint = free_endpoint()
+    robot = Robot("r1", endpoint, TOKEN, tmp_path / "r1.jsonl")  # a peer of the router: it starts without it
+    processes(robot)
+    wait_for(lambda: tmp_path.joinpath("r1.jsonl").exists() and len(robot.events()) >= 6, 20,
+             what="the robot's patrol recorded with no router up")
+    processes(Router(endpoint=endpoint))
+    dash = Dashboard(endpoint, "--zenoh-mode", "client", "--zenoh-token", TOKEN, listen=False)
+    processes(dash)
+    wait_for(lambda: dash.machines().get("r1:patrol", {}).get("running"), 20, what="r1:patrol running")
+    preempted_the_dashboard_has_the_robots_log(dash, robot, 1)

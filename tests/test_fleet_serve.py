@@ -11,9 +11,9 @@ import sys
 import time
 
 import fsm
-import httpx
 import pytest
-from fleet_support import ROOT, Dashboard, Proxy, Robot, free_endpoint, run_published, slow_loop
+from fleet_support import (ROOT, Dashboard, Proxy, Robot, free_endpoint, preempted_the_dashboard_has_the_robots_log,
+                           run_published, slow_loop)
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
@@ -34,29 +34,6 @@ def dashboard_with():
     yield start
     for dash in started:
         dash.stop()
-
-
-def history(dash: Dashboard, name: str, since: int) -> list[dict]:
-    """The dashboard's events of machine ``name`` from seq ``since`` on."""
-    events: list[dict] = []
-    while since is not None:
-        page = httpx.get(dash.base + "/api/machines/%s/history" % name,
-                         params={"token": dash.token, "since": since, "limit": 1000}).json()
-        events += page["events"]
-        since = page["next"] if page["more"] else None
-    return events
-
-
-def preempted_the_dashboard_has_the_robots_log(dash: Dashboard, robot: Robot, since: int) -> None:
-    """Preempt r1:patrol from ``dash``: its run ends, and the dashboard's events from ``since`` on are
-    those of the robot's own log."""
-    answer = dash.post("/api/machines/r1:patrol/preempt", {})
-    assert answer.status_code == 202, answer.text
-    assert robot.ended() == 0
-    own = [e for e in robot.events() if e["seq"] >= since]
-    wait_for(lambda: dash.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
-    seen = history(dash, "r1:patrol", since)
-    assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[-3:], own[-3:])
 
 
 @pytest.fixture

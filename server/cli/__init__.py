@@ -22,7 +22,7 @@ import argparse
 import sys
 from typing import Protocol
 
-from . import bag_import, demo, export, replay, run, serve
+from . import bag_import, demo, export, replay, router, run, serve
 from .serving import CannotServe
 
 
@@ -36,7 +36,7 @@ class Subcommand(Protocol):
 
 
 SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "export": export,
-                                      "import": bag_import, "demo": demo}
+                                      "import": bag_import, "demo": demo, "router": router}
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -64,13 +64,13 @@ def main(args: argparse.Namespace) -> int:
 
     if not args.verbose:
         _quiet_loggers()
+    robot = zenoh_robot(args, can_start=False)  # first: an endpoint Zenoh cannot use ends the command before it starts
     record_path = args.record or os.path.join("runs", time.strftime("demo-%Y%m%d-%H%M%S.jsonl"))
     os.makedirs(os.path.dirname(os.path.abspath(record_path)), exist_ok=True)
     demo = SimDemo(seed=args.seed, fast=args.fast, scene=not args.headless)
     machine = demo.build_machine()
     recorder = Recorder(record_path)
     rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
-    robot = zenoh_robot(args, can_start=False)
 
     def record_pose(fields: dict) -> bool:
         if rep.run is None:  # not started yet: a log opens with the machine's structure

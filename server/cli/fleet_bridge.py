@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING, Callable
 from fsm.control.handle import ControlError
 
 from ..remote_control import RemoteHandle, not_connected, taken
-from .serving import SWITCH_INTERVAL
+from .serving import SWITCH_INTERVAL, CannotServe
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -49,7 +49,8 @@ def add_zenoh_arguments(parser: argparse.ArgumentParser, publish: bool) -> None:
                              ("with --zenoh: the token to control the robots' machines with; ROBOT=TOKEN for one "
                               "robot's (default: $%s; none: the fleet is watched, not controlled)" % TOKEN_ENV))
     parser.add_argument("--zenoh-mode", choices=("peer", "client"), default="peer",
-                        help="with --zenoh: peer (default), or client of a zenohd router")
+                        help="with --zenoh: peer (default; a robot connecting to a router stays one), or client of "
+                             "a router (a dashboard behind one)")
     parser.add_argument("--zenoh-scouting", action="store_true",
                         help="with --zenoh: find the others on the LAN by multicast (off unless asked)")
     parser.add_argument("--zenoh-config", type=zenoh_config_file, metavar="FILE",
@@ -89,13 +90,17 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
         return None
     from fleet.robot import ZenohRobot
 
-    token = zenoh_tokens(args).get(None)
-    if token is None:
-        token = secrets.token_urlsafe(24)
+    given = zenoh_tokens(args).get(None)
+    token = given or secrets.token_urlsafe(24)
+    try:
+        robot = ZenohRobot(args.zenoh, connect=args.zenoh_connect, listen=args.zenoh_listen, mode=args.zenoh_mode,
+                           scouting=args.zenoh_scouting, token=token, can_start=can_start,
+                           config_file=args.zenoh_config)
+    except ValueError as exc:  # a name Zenoh cannot take, an endpoint it cannot use
+        raise CannotServe(str(exc)) from None
+    if given is None:
         print("fsmscope: the token of robot %r's controls: %s (serve --zenoh-token %s=%s)"
               % (args.zenoh, token, args.zenoh, token), file=sys.stderr, flush=True)
-    robot = ZenohRobot(args.zenoh, connect=args.zenoh_connect, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                       scouting=args.zenoh_scouting, token=token, can_start=can_start, config_file=args.zenoh_config)
     print("fsmscope: publishing on Zenoh as robot %r" % args.zenoh, file=sys.stderr, flush=True)
     return robot
 
@@ -228,9 +233,12 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
             if up and entry.remote is not None and entry.remote.link is not None:
                 entry.remote.bind(entry.remote.link)  # the lease said again: its process may be a new one
 
-    watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),
-                           connect=args.zenoh, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                           scouting=args.zenoh_scouting, config_file=args.zenoh_config, settled=inbox.wake)
+    try:
+        watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),
+                               connect=args.zenoh, listen=args.zenoh_listen, mode=args.zenoh_mode,
+                               scouting=args.zenoh_scouting, config_file=args.zenoh_config, settled=inbox.wake)
+    except ValueError as exc:
+        raise CannotServe(str(exc)) from None
     print("fsmscope: following the fleet on Zenoh (%s)" % ", ".join(
         ["connect " + e for e in args.zenoh] + ["listen " + e for e in args.zenoh_listen]
         + (["multicast scouting"] if args.zenoh_scouting else [])) or "no endpoint", file=sys.stderr, flush=True)

@@ -8,7 +8,7 @@ import argparse
 import sys
 
 from .fleet_bridge import add_zenoh_arguments
-from .serving import add_server_arguments, announce_viewer, start_server, wait_for_interrupt
+from .serving import CannotServe, add_server_arguments, announce_viewer, start_server, wait_for_interrupt
 
 HELP = "serve the dashboard for machines of other processes (they publish to /api/ingest)"
 PASSES_ARGUMENTS_ON = False
@@ -25,7 +25,11 @@ def main(args: argparse.Namespace) -> int:
     if args.zenoh is not None:
         from .fleet_bridge import start_fleet
 
-        start_fleet(args, srv.hub)
+        try:
+            start_fleet(args, srv.hub)
+        except CannotServe:
+            srv.stop()
+            raise
     print("fsmscope: serving the dashboard at %s" % srv.url, file=sys.stderr)
     if args.zenoh is not None:
         print("fsmscope: the fleet overview at %s" % (srv.base_url + "/fleet" + ("?token=" + srv.token if srv.token else "")), file=sys.stderr)

@@ -18,8 +18,8 @@ if TYPE_CHECKING:
 
 
 class CannotServe(Exception):
-    """The server cannot start with these arguments (the port is taken, a public address has no
-    token): the command ends with exit code 1 and this reason."""
+    """The command cannot start with these arguments (the port is taken, a public address has no
+    token, Zenoh cannot open its session): it ends with exit code 1 and this reason."""
 
 
 def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> None:

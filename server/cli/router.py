@@ -1,0 +1,45 @@
+"""``fsmscope router``: a Zenoh router for a site's robots and dashboards, for a computer without
+``zenohd`` (Zenoh's router is a Rust program, not a Python package). It is a Zenoh session in
+router mode: the routing code ``zenohd`` runs, without zenohd's plugins (REST, storages). Robots and
+dashboards are its clients (``--zenoh-mode client --zenoh-connect tcp/ROUTER:7447``); routers of
+other sites are joined with ``--connect`` (docs/fleet.md, "Robots behind a zenohd router")."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from .fleet_bridge import zenoh_config_file
+from .serving import CannotServe, wait_for_interrupt
+
+HELP = "route Zenoh for a fleet's robots and dashboards (a stand-in for zenohd)"
+PASSES_ARGUMENTS_ON = False
+DEFAULT_LISTEN = "tcp/127.0.0.1:7447"
+
+
+def arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--listen", action="append", default=[], metavar="ENDPOINT",
+                        help="listen on this endpoint for robots, dashboards and other routers (default: %s; "
+                             "tcp/0.0.0.0:7447 for a site's network)" % DEFAULT_LISTEN)
+    parser.add_argument("--connect", action="append", default=[], metavar="ENDPOINT",
+                        help="connect to another site's router at this endpoint (tcp/HOST:PORT)")
+    parser.add_argument("--scouting", action="store_true",
+                        help="find peers on the LAN by multicast (off unless asked)")
+    parser.add_argument("--zenoh-config", type=zenoh_config_file, metavar="FILE",
+                        help="a Zenoh configuration file (JSON5): TLS certificates for tls/ endpoints, access "
+                             "control; the options above are applied over it")
+
+
+def main(args: argparse.Namespace) -> int:
+    from fleet.config import open_session
+
+    listen = args.listen or [DEFAULT_LISTEN]
+    try:
+        session = open_session(args.connect, listen, "router", args.scouting, args.zenoh_config)
+    except ValueError as exc:
+        raise CannotServe(str(exc)) from None
+    print("fsmscope: routing Zenoh on %s; robots and dashboards connect with --zenoh-mode client "
+          "--zenoh-connect ENDPOINT; Ctrl-C stops" % ", ".join(listen), file=sys.stderr, flush=True)
+    wait_for_interrupt()
+    session.close()
+    return 0

@@ -11,8 +11,9 @@ process that only burns as much CPU as the watcher took, without Zenoh, to tell 
 
 The speed of one core of this machine drifts by half between runs of seconds, so the rates are
 backed by a count that does not: the instructions a transition costs (valgrind's callgrind, which
-counts the work of every thread), with and without the robot, of runs of ``COUNTED`` transitions
-less those of an empty run.
+counts the work of every thread of the loop's process), without the robot, with it and nobody
+listening, and with it and the watcher following, of runs of ``COUNTED`` transitions less those of
+an empty run. The watcher's own work, in its process, is not counted: on a robot it runs elsewhere.
 
     .venv/bin/python bench/fleet_cost.py [--runs 16] [--no-instructions]
 """
@@ -68,7 +69,7 @@ WARM_UP = 2_000  # transitions run first, untimed: a watcher joins the new machi
 JOINING = 1.0  # s given to the watcher to join (ask the machine's state and its history, once)
 
 
-def prepared(srv: ServerThread, robot: ZenohRobot | None) -> Callable[[], int]:
+def prepared(srv: ServerThread, robot: ZenohRobot | None, joining: float = JOINING) -> Callable[[], int]:
     """A new two-state loop served by ``srv`` and published by ``robot`` (if any), warmed up: its
     ``run``. Each round's machine is a new one, and a watcher following the robot joins it (asks its
     state and the history the robot keeps, once), as a dashboard does once per machine: that is done
@@ -84,7 +85,7 @@ def prepared(srv: ServerThread, robot: ZenohRobot | None) -> Callable[[], int]:
         runtime.LOOP_TRANSITIONS = timed
     if robot is not None:
         robot.flush()
-    time.sleep(JOINING)
+    time.sleep(joining)
     return run
 
 
@@ -98,9 +99,9 @@ def timed_rate(run: Callable[[], int], robot: ZenohRobot | None) -> float:
     return count / elapsed
 
 
-def rate(srv: ServerThread, robot: ZenohRobot | None) -> float:
+def rate(srv: ServerThread, robot: ZenohRobot | None, joining: float = JOINING) -> float:
     """Transitions/s of a new loop, warmed up, published by ``robot`` (if any)."""
-    return timed_rate(prepared(srv, robot), robot)
+    return timed_rate(prepared(srv, robot, joining), robot)
 
 
 def followed_rate(srv: ServerThread, robot: ZenohRobot, watcher: subprocess.Popen, cpu: list[float]) -> float:
@@ -125,39 +126,46 @@ def burnt_rate(srv: ServerThread, share: float) -> float:
 COUNTED = 20_000  # transitions of a run under callgrind (about 50 times slower)
 
 
-def loop_once(with_robot: bool, transitions: int) -> None:
-    """One run of the loop with the hub, and the robot if asked: what callgrind counts (the warm-up's
-    instructions are in the runs of ``transitions`` and of none alike)."""
+def loop_once(case: str, transitions: int, endpoint: str) -> None:
+    """One run of the loop with the hub, and the robot if the case has one ("quiet": nobody listens;
+    "followed": a watcher listening at ``endpoint`` follows it): what callgrind counts (the warm-up's
+    instructions, and the watcher's join, are in the runs of ``transitions`` and of none alike)."""
     runtime.LOOP_TRANSITIONS = transitions
     fleet.robot.LINGER = 1.0  # callgrind slows the loop: batches as full as at full speed (MAX_BATCH)
     fsm.set_loggers(*[lambda msg: None] * 4)
     srv = ServerThread().start()
-    robot = ZenohRobot("bench") if with_robot else None
-    rate(srv, robot)
+    robot = {"base": None, "quiet": lambda: ZenohRobot("bench"),
+             "followed": lambda: ZenohRobot("bench", connect=[endpoint])}[case]
+    robot = robot and robot()
+    rate(srv, robot, joining=10.0)  # the join's answers, slowed too, are over before the timed run
     if robot is not None:
         robot.close()
     srv.stop()
 
 
-def instructions(with_robot: bool, transitions: int) -> int:
-    """The instructions of a process running ``loop_once`` (every thread's, start-up included)."""
+def instructions(case: str, transitions: int, endpoint: str) -> int:
+    """The instructions of a process running ``loop_once`` (every thread's, start-up included; not
+    the watcher's, which runs in a process of its own)."""
     out = subprocess.run(["valgrind", "--tool=callgrind", "--callgrind-out-file=/dev/null", sys.executable,
-                          __file__, "--once", "robot" if with_robot else "base", str(transitions)],
+                          __file__, "--once", case, str(transitions), endpoint],
                          cwd=ROOT, capture_output=True, text=True, check=True).stderr
     return int(re.search(r"Collected : (\d+)", out).group(1))
 
 
-def instruction_rows() -> list[tuple[str, str, str, str]]:
-    """Instructions per transition without and with the robot: the table's rows."""
+def instruction_rows(endpoint: str) -> list[tuple[str, str, str, str]]:
+    """Instructions per transition without the robot, with it and nobody listening, and with the
+    watcher listening at ``endpoint`` following it: the table's rows. Counted, they do not depend on
+    what else runs on the two cores, as the rates do."""
     if shutil.which("valgrind") is None:
         return [("instructions per transition (valgrind is not installed)", "", "-", verdict(None))]
-    per = {}
-    for with_robot in (False, True):
-        per[with_robot] = (instructions(with_robot, COUNTED) - instructions(with_robot, 0)) / COUNTED
-    cost = per[True] / per[False] - 1
-    return [("instructions per transition, the loop with the hub", "", "%.0f" % per[False], verdict(None)),
-            ("  + ZenohRobot, nobody listening", "<= 10 % more", "%.0f (%+.1f %%)" % (per[True], 100 * cost),
-             verdict(cost <= 0.10))]
+    per = {case: (instructions(case, COUNTED, endpoint) - instructions(case, 0, endpoint)) / COUNTED
+           for case in ("base", "quiet", "followed")}
+    rows = [("instructions per transition, the loop with the hub", "", "%.0f" % per["base"], verdict(None))]
+    for case, said in (("quiet", "nobody listening"), ("followed", "a dashboard's watcher following")):
+        cost = per[case] / per["base"] - 1
+        rows.append(("  + ZenohRobot, %s" % said, "<= 10 % more", "%.0f (%+.1f %%)" % (per[case], 100 * cost),
+                     verdict(cost <= 0.10)))
+    return rows
 
 
 def cpu_seconds(pid: int) -> float:
@@ -179,10 +187,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", type=int, default=16)
     parser.add_argument("--no-instructions", action="store_true", help="skip the count under callgrind (minutes)")
-    parser.add_argument("--once", nargs=2, metavar=("CASE", "TRANSITIONS"), help=argparse.SUPPRESS)
+    parser.add_argument("--once", nargs=3, metavar=("CASE", "TRANSITIONS", "ENDPOINT"), help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.once:
-        loop_once(args.once[0] == "robot", int(args.once[1]))
+        loop_once(args.once[0], int(args.once[1]), args.once[2])
         return
     fsm.set_loggers(*[lambda msg: None] * 4)
     srv = ServerThread().start()
@@ -208,6 +216,7 @@ def main() -> None:
                 ratios[name].append(rates[name] / rates["base"])
         alone.close()
         watched.close()
+        counted = [] if args.no_instructions else instruction_rows(endpoint)
     finally:
         watcher.kill()
         srv.stop()
@@ -225,7 +234,7 @@ def main() -> None:
                      verdict(None)),
                     ("  no robot, beside a process burning as much CPU (no Zenoh)", "", "%+.1f %%" % (100 * (c - 1)),
                      verdict(None)),
-                    *([] if args.no_instructions else instruction_rows()),
+                    *counted,
                 ])
 
 

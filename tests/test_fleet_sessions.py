@@ -1,6 +1,6 @@
 """What fsmscope opens a Zenoh session as: it listens only where it is told to (Zenoh's own default
 would have a peer listen on every interface), and an endpoint Zenoh cannot use ends the command
-with why, before it starts."""
+with why, before it starts; a command says where its session meets the others."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import subprocess
 import sys
 
 import pytest
-from fleet_support import ROOT, free_endpoint
+from fleet_support import ROOT, free_endpoint, started, stop
 
 from fleet.robot import ZenohRobot
 
@@ -69,3 +69,17 @@ def test_a_router_whose_port_is_taken_says_so():
     assert done.returncode == 1
     assert "Address already in use" in done.stderr
     assert "Traceback" not in done.stderr
+
+
+def test_a_dashboard_given_no_endpoint_says_it_meets_nobody():
+    proc, found = started(["serve", "--port", "0", "--zenoh"], r"following the fleet on Zenoh \((.*)\)")
+    stop(proc)
+    assert found.group(1) == "no endpoint and no scouting: it meets nobody"
+
+
+def test_a_dashboard_says_where_it_meets_the_robots():
+    endpoint = free_endpoint()
+    proc, found = started(["serve", "--port", "0", "--zenoh", "--zenoh-listen", endpoint],
+                          r"following the fleet on Zenoh \((.*)\)")
+    stop(proc)
+    assert found.group(1) == "listen " + endpoint

@@ -101,7 +101,8 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
     if given is None:
         print("fsmscope: the token of robot %r's controls: %s (serve --zenoh-token %s=%s)"
               % (args.zenoh, token, args.zenoh, token), file=sys.stderr, flush=True)
-    print("fsmscope: publishing on Zenoh as robot %r" % args.zenoh, file=sys.stderr, flush=True)
+    print("fsmscope: publishing on Zenoh as robot %r (%s)" % (args.zenoh, reach(args.zenoh_connect, args)),
+          file=sys.stderr, flush=True)
     return robot
 
 
@@ -239,7 +240,14 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
                                scouting=args.zenoh_scouting, config_file=args.zenoh_config, settled=inbox.wake)
     except ValueError as exc:
         raise CannotServe(str(exc)) from None
-    print("fsmscope: following the fleet on Zenoh (%s)" % ", ".join(
-        ["connect " + e for e in args.zenoh] + ["listen " + e for e in args.zenoh_listen]
-        + (["multicast scouting"] if args.zenoh_scouting else [])) or "no endpoint", file=sys.stderr, flush=True)
+    print("fsmscope: following the fleet on Zenoh (%s)" % reach(args.zenoh, args), file=sys.stderr, flush=True)
     return watcher
+
+
+def reach(connect: list[str], args: argparse.Namespace) -> str:
+    """Where the command's Zenoh session meets the others, for the line it starts with: a session
+    given no endpoint, no scouting and no configuration file meets nobody, and says so."""
+    parts = (["connect " + e for e in connect] + ["listen " + e for e in args.zenoh_listen]
+             + (["multicast scouting"] if args.zenoh_scouting else [])
+             + (["configured by " + args.zenoh_config] if args.zenoh_config else []))
+    return ", ".join(parts) or "no endpoint and no scouting: it meets nobody"

@@ -1,8 +1,9 @@
 """``fsmscope router``: a Zenoh router for a site's robots and dashboards, for a computer without
 ``zenohd`` (Zenoh's router is a Rust program, not a Python package). It is a Zenoh session in
-router mode: the routing code ``zenohd`` runs, without zenohd's plugins (REST, storages). Robots and
-dashboards are its clients (``--zenoh-mode client --zenoh-connect tcp/ROUTER:7447``); routers of
-other sites are joined with ``--connect`` (docs/fleet.md, "Robots behind a zenohd router")."""
+router mode: the routing code ``zenohd`` runs, without zenohd's plugins (REST, storages). Robots
+connect to it as peers (``--zenoh-connect tcp/ROUTER:7447``), dashboards as its clients (``--zenoh
+tcp/ROUTER:7447 --zenoh-mode client``); routers of other sites are joined with ``--connect``
+(docs/fleet.md, "Robots behind a zenohd router")."""
 
 from __future__ import annotations
 
@@ -38,8 +39,8 @@ def main(args: argparse.Namespace) -> int:
         session = open_session(args.connect, listen, "router", args.scouting, args.zenoh_config)
     except ValueError as exc:
         raise CannotServe(str(exc)) from None
-    print("fsmscope: routing Zenoh on %s; robots and dashboards connect with --zenoh-mode client "
-          "--zenoh-connect ENDPOINT; Ctrl-C stops" % ", ".join(listen), file=sys.stderr, flush=True)
+    print("fsmscope: routing Zenoh on %s; robots connect with --zenoh-connect ENDPOINT, dashboards with "
+          "--zenoh ENDPOINT --zenoh-mode client; Ctrl-C stops" % ", ".join(listen), file=sys.stderr, flush=True)
     wait_for_interrupt()
     session.close()
     return 0

@@ -134,9 +134,9 @@ def loop_once(case: str, transitions: int, endpoint: str) -> None:
     fleet.robot.LINGER = 1.0  # callgrind slows the loop: batches as full as at full speed (MAX_BATCH)
     fsm.set_loggers(*[lambda msg: None] * 4)
     srv = ServerThread().start()
-    robot = {"base": None, "quiet": lambda: ZenohRobot("bench"),
-             "followed": lambda: ZenohRobot("bench", connect=[endpoint])}[case]
-    robot = robot and robot()
+    make = {"base": None, "quiet": lambda: ZenohRobot("bench"),
+            "followed": lambda: ZenohRobot("bench", connect=[endpoint])}[case]
+    robot = make() if make else None
     rate(srv, robot, joining=10.0)  # the join's answers, slowed too, are over before the timed run
     if robot is not None:
         robot.close()

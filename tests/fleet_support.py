@@ -158,7 +158,7 @@ class Dashboard:
     (``listen``), or only connecting where its options say (a router's client)."""
 
     def __init__(self, *options: str, listen: bool = True) -> None:
-        self.endpoint = free_endpoint()
+        self.endpoint = free_endpoint() if listen else None
         own = ["--zenoh-listen", self.endpoint] if listen else []
         self.proc, found = started(["serve", "--port", "0", "--zenoh", *own, *options],
                                    r"serving the dashboard at (http://\S+)")

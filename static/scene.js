@@ -1,6 +1,6 @@
 // The 3D view of a simulated robot, when the server has one (GET /api/scene): viser's own page
 // in an iframe. viser serves on its own loopback port; embedding it keeps its 30 Hz websocket
-// off our server (docs/architecture.md says why we did not proxy it). Looking back, the page asks
+// off our server (docs/decisions/06-the-3d-view-an-iframe-to-viser-not-a-proxy.md says why we did not proxy it). Looking back, the page asks
 // the server to draw the recorded pose of the instant (POST /api/scene/pose) instead of the live arm.
 
 export class SceneView {

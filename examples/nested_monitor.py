@@ -16,15 +16,15 @@ import threading
 import time
 
 import fsm as smach
-from fsm.actionlib import SimpleActionServer
-from fsm.bus import get_bus
+from fsm.ros.actionlib import SimpleActionServer
+from fsm.ros.bus import get_bus
 
 try:
     MonitorState = smach.MonitorState
     SimpleActionState = smach.SimpleActionState
 except AttributeError:
-    from fsm.monitor_state import MonitorState
-    from fsm.simple_action_state import SimpleActionState
+    from fsm.ros.monitor_state import MonitorState
+    from fsm.ros.simple_action_state import SimpleActionState
 
 STOP_TOPIC = "sm_stop"
 

@@ -12,15 +12,15 @@ import random
 import time
 
 import fsm as smach
-from fsm.actionlib import SimpleActionServer
-from fsm.bus import get_bus
+from fsm.ros.actionlib import SimpleActionServer
+from fsm.ros.bus import get_bus
 
 try:
     ServiceState = smach.ServiceState
     SimpleActionState = smach.SimpleActionState
 except AttributeError:
-    from fsm.service_state import ServiceState
-    from fsm.simple_action_state import SimpleActionState
+    from fsm.ros.service_state import ServiceState
+    from fsm.ros.simple_action_state import SimpleActionState
 
 
 def time_scale(default: float = 1.0) -> float:

@@ -6,7 +6,7 @@ STAMP    := $(VENV)/.installed
 # Firefox ESR for the browser tests, openssl for the fleet's TLS test certificates.
 APT_PKGS := graphviz chromium firefox-esr fonts-dejavu-core openssl
 
-.PHONY: install apt demo test bench clean
+.PHONY: install apt demo test test-fast bench clean
 
 install: apt $(STAMP)
 
@@ -29,8 +29,14 @@ apt:
 demo: install
 	$(VENV)/bin/fsmscope demo
 
+# Three workers on two cores: most tests wait on processes, sockets and pages rather than compute.
+# The browser and demo tests run one after the other in one of them (tests/conftest.py).
 test: install
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 3 --dist loadgroup
+
+# The unit layer alone: the runtime, the logs and the formats, no server, no browser (under a minute).
+test-fast: install
+	$(PY) -m pytest -q -m unit
 
 # Every benchmark prints a table (medians) against its target; all of them take ~20 minutes.
 bench: install

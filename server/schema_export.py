@@ -1,7 +1,7 @@
 """The event schema (fsm/observation/schema.py) as the browser and the docs read it.
 
 ``static/schema.js`` and the field tables of ``docs/events.md`` are generated from the one
-definition in ``fsm.observation.schema``; ``tests/test_schema_export.py`` regenerates both and fails on any
+definition in ``fsm.observation.schema``; ``tests/unit/test_schema_export.py`` regenerates both and fails on any
 difference. After changing the schema: ``python -m server.schema_export``.
 """
 
@@ -24,7 +24,7 @@ def javascript() -> str:
     escapes = {chr(code): text for code, text in schema.ID_ESCAPES.items()}
     pattern = "".join("\\u%04x" % ord(c) for c in escapes)
     return """// Generated from fsm/observation/schema.py by `python -m server.schema_export`: do not edit by hand
-// (tests/test_schema_export.py fails when this file and the Python definition differ).
+// (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
 
 /** The event schema version this page reads. */
 export const SCHEMA_VERSION = %(version)d;

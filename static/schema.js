@@ -1,5 +1,5 @@
 // Generated from fsm/observation/schema.py by `python -m server.schema_export`: do not edit by hand
-// (tests/test_schema_export.py fails when this file and the Python definition differ).
+// (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
 
 /** The event schema version this page reads. */
 export const SCHEMA_VERSION = 1;

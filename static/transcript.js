@@ -74,7 +74,7 @@ export function containerType(ev, node) {
 
 /**
  * Events, fed one at a time in order, as the SMACH log lines they stand for: the lines of
- * fsm/logfiles/transcript.py's Transcript, word for word (tests/test_browser_transcript.py
+ * fsm/logfiles/transcript.py's Transcript, word for word (tests/browser/test_browser_transcript.py
  * compares them over a recorded run of every example). A Concurrence that logged
  * "Concurrence serviced preempt." prints no "Concurrent Outcomes" line: that needs the events before.
  */

@@ -277,8 +277,8 @@ FRESH_EPISODE = 1.5  # s: an episode (about 6 s at real time) begun this recentl
 
 class SharedDemo:
     """One real ``fsmscope demo`` (real time, its default deadman) for the demo's tests of several
-    modules: started when a test first needs it (``process()``), stopped by tests/conftest.py after
-    the last test in a row that does (``stop()``). Whoever uses it leaves it as it was found:
+    modules: started when a test first needs it (``process()``), stopped by tests/demo/conftest.py after
+    the folder's last test (``stop()``). Whoever uses it leaves it as it was found:
     ``let_go()`` after every test (no breakpoint, nothing held, no lease, the loop running)."""
 
     PAGE = "tests-let-go"  # the page id of the requests that let the machine go

@@ -1,9 +1,22 @@
-"""Shared fixtures: captured log lines, the runtime's globals restored after every test, a live
-server, a private bus and its action servers, Debian's Chromium for the browser tests, and one
-``fsmscope demo`` process shared by the demo's tests of several modules."""
+"""The suite's layers and shared fixtures.
+
+Each folder is a layer, registered as a marker of the same name (``pytest -m unit``):
+
+* ``unit/``: no server, no browser, no network: the runtime, the logs, the formats, the simulator
+  (``make test-fast``);
+* ``server/``: a real uvicorn, real websockets, the commands run as processes;
+* ``fleet/``: real Zenoh sessions on the loopback;
+* ``browser/``: real Chromium (and Firefox) against real servers;
+* ``demo/``: the real ``fsmscope demo`` (MuJoCo, viser): a recorded episode, and one live process
+  shared by its tests (demo/conftest.py);
+* ``parity/``: fsm and the original SMACH run side by side.
+
+Shared fixtures: captured log lines, the runtime's globals restored after every test, a live server,
+a private bus and its action servers, Debian's Chromium, and one recorded demo episode."""
 
 import os
 import shutil
+from pathlib import Path
 
 import fsm
 import fsm.core.log
@@ -143,38 +156,39 @@ def headless_demo_log(tmp_path_factory):
     return path
 
 
-# The demo the tests share (browser_support.SharedDemo), made by the first test that needs it.
-_shared_demo: list = []
+LAYERS = ("unit", "server", "fleet", "browser", "demo", "parity")
+TESTS = Path(__file__).resolve().parent
 
 
-@pytest.fixture(scope="session")
-def shared_demo(tmp_path_factory):
-    """One real ``fsmscope demo`` at real time (episodes of about 6 s, a pause of 1 s between them) for
-    the demo's tests of several modules: ``process()`` starts it, ``let_go()`` leaves it as it was
-    found. pytest_runtest_teardown below stops it after the last test in a row that uses it, so it
-    never runs (and costs CPU) behind the tests that do not."""
-    from browser_support import SharedDemo
-
-    shared = SharedDemo(tmp_path_factory.mktemp("shared-demo"))
-    _shared_demo.append(shared)
-    yield shared
-    _shared_demo.remove(shared)
-    assert shared.stop() in (None, 130)  # interrupted, cleanly
+def layer_of(item: pytest.Item) -> str | None:
+    """The layer a test belongs to: the folder under tests/ it lives in."""
+    folder = item.path.relative_to(TESTS).parts[0]
+    return folder if folder in LAYERS else None
 
 
-@pytest.fixture
-def demo(shared_demo):
-    """The shared demo's process, let go after the test (no breakpoint, no hold, no lease, running)."""
-    yield shared_demo.process()
-    shared_demo.let_go()
+def pytest_collection_modifyitems(items):
+    """Mark every test with its layer. Under xdist (make test), the tests that drive a browser or the
+    shared demo run one after the other in one worker (one Chromium at a time on two cores), the
+    others spread over the remaining workers."""
+    for item in items:
+        layer = layer_of(item)
+        if layer is not None:
+            item.add_marker(layer)
+        if layer in ("browser", "demo"):
+            item.add_marker(pytest.mark.xdist_group("browser"))
 
 
-@pytest.hookimpl(wrapper=True)
-def pytest_runtest_teardown(item, nextitem):
-    """After the last test in a row that uses the shared demo (and its fixtures' teardown), stop it."""
-    try:
-        return (yield)
-    finally:
-        if _shared_demo and "shared_demo" in item.fixturenames and (
-                nextitem is None or "shared_demo" not in nextitem.fixturenames):
-            assert _shared_demo[0].stop() in (None, 130)  # interrupted, cleanly
+@pytest.fixture(autouse=True)
+def _machine_lines_kept_with_the_test(request):
+    """Past the unit layer, machines run in threads of their own (a server's, a robot's), and a line
+    they print while pytest switches between a test's phases (its capture off for an instant) landed
+    among the dots. Their lines are kept with the test instead, and shown when it fails."""
+    if layer_of(request.node) in (None, "unit"):
+        yield
+        return
+    lines: list[str] = []
+    fsm.set_loggers(*[(lambda msg, prefix=prefix: lines.append(prefix + str(msg)))
+                      for prefix in ("[  INFO ] : ", "[  WARN ] : ", "[ DEBUG ] : ", "[ ERROR ] : ")])
+    yield
+    if lines:
+        request.node.add_report_section("call", "fsm log", "\n".join(lines))

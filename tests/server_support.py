@@ -140,3 +140,23 @@ def blob_loop(n, size=2000):
         fsm.StateMachine.add("A", fsm.CBState(step, outcomes=["again", "stop"], output_keys=["blob"]),
                              {"again": "A", "stop": "done"})
     return sm
+
+
+def looping_machine():
+    """A <-> B until ``stop`` is set; each writes its count into userdata ``n``."""
+    stop = threading.Event()
+    count = {"n": 0}
+
+    def tick(ud):
+        time.sleep(0.002)
+        count["n"] += 1
+        ud.n = count["n"]
+        return "stop" if stop.is_set() else "go"
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
+                             {"go": "B", "stop": "done"})
+        fsm.StateMachine.add("B", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
+                             {"go": "A", "stop": "done"})
+    return sm, stop

@@ -13,7 +13,7 @@ from server.testing.browser import CHROMIUM, open_page
 from server.testing.demo_process import DemoProcess
 from server.testing.polling import wait_for
 
-from test_server_debug import looping_machine
+from server_support import looping_machine
 
 LEASE_PILL = "#lease-state"
 

@@ -170,7 +170,7 @@ def test_a_script_that_exits_without_closing_its_recorder_has_every_event_writte
               "from recording_support import two_state_loop\n"
               "recorder = fsm.Recorder(%r, flush_interval=3600, flush_bytes=1 << 30)\n"
               "fsm.attach(two_state_loop(50), recorder).root.execute()\n"
-              "sys.stderr.write(\"events=%%d\" %% recorder.events)\n") % (os.path.dirname(__file__), str(path))
+              "sys.stderr.write(\"events=%%d\" %% recorder.events)\n") % (os.path.dirname(os.path.dirname(__file__)), str(path))
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     assert len(_lines(path)) == int(done.stderr.rsplit("events=", 1)[1]) > 100

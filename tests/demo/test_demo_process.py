@@ -1,5 +1,5 @@
 """`fsmscope demo` as a user runs it: a real process, stopped by a signal mid-episode (headless), and
-preempted and started again over REST (the demo the tests share, tests/conftest.py: ``demo``)."""
+preempted and started again over REST (the demo the tests share, tests/demo/conftest.py: ``demo``)."""
 
 from __future__ import annotations
 

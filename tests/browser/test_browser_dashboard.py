@@ -7,6 +7,7 @@ outright and start it again on the same port, the way a crashed `fsmscope run` c
 from __future__ import annotations
 
 import json
+import os
 import secrets
 import subprocess
 import sys
@@ -20,7 +21,7 @@ from server.testing.demo_process import free_port
 from server.testing.polling import wait_for
 
 XSS = "<img src=x onerror=alert(1)>"
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 SHOTS = ROOT / "build" / "screenshots"
 
 
@@ -100,8 +101,10 @@ class ServerProcess:
 
     def start(self) -> None:
         with open(self.log, "ab") as log:
+            # The child imports this file's helpers from tests/, beside the folder it runs from.
+            path = os.pathsep.join(filter(None, [str(ROOT / "tests"), os.environ.get("PYTHONPATH")]))
             self.proc = subprocess.Popen([sys.executable, __file__, "--serve", str(self.port), self.token],
-                                         cwd=str(ROOT), stdout=log, stderr=log)
+                                         cwd=str(ROOT), stdout=log, stderr=log, env=dict(os.environ, PYTHONPATH=path))
         wait_for(self._answers, 15, interval=0.05,
                  what=lambda: "the server to answer; its log: " + self.log.read_text()[-2000:])
 

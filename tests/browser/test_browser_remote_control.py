@@ -7,7 +7,7 @@ import pytest
 from browser_support import watch
 from server.testing.polling import wait_for
 
-from test_remote_control import published  # noqa: F401 (the fixture: a publishing subprocess)
+from publishing_support import published  # noqa: F401 (the fixture: a publishing subprocess)
 
 
 @pytest.fixture

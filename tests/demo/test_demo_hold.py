@@ -1,6 +1,6 @@
 """The demo's episode loop keeps an operator's stop: a preempt pressed in the pause between two
 episodes holds the loop until Start (it used to be lost with a 409), and "stop after this
-episode" lets the running one finish first. On the demo the tests share (tests/conftest.py: ``demo``,
+episode" lets the running one finish first. On the demo the tests share (tests/demo/conftest.py: ``demo``,
 real time: episodes of several seconds with a pause of 1 s between them)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import time
 import pytest
 from browser_support import wait_for_a_fresh_episode
 
-from test_demo_process import api, wait_for_machine
+from .test_demo_process import api, wait_for_machine
 
 
 def runs_between(demo, seconds: float) -> int:

@@ -9,7 +9,7 @@ from server.lease import Deadman
 from server.testing.polling import wait_for
 
 from server_support import client
-from test_server_debug import looping_machine
+from server_support import looping_machine
 
 DEADMAN_AFTER = 1.5
 

@@ -127,7 +127,7 @@ def test_hostile_events_in_a_log_never_break_headless_replay(tmp_path_factory, e
 @settings(max_examples=6, deadline=None, suppress_health_check=list(HealthCheck), database=None)
 @given(events=st.lists(hostile(), min_size=3, max_size=10))
 def test_hostile_events_in_a_log_never_break_replay_in_the_dashboard(tmp_path_factory, events):
-    # A line of a newer schema version ends any replay on purpose (exit 2; tests/test_log_reader.py).
+    # A line of a newer schema version ends any replay on purpose (exit 2; tests/unit/test_log_reader.py).
     events = [e for e in events if not (type(e.get("v")) is int and e["v"] > 1)]
     log = tmp_path_factory.mktemp("hostile") / "run.jsonl"
     log.write_text("\n".join(json.dumps(e) for e in run_of(flat_root("A", "B")) + events) + "\n")

@@ -1,7 +1,7 @@
 """The browser's transcript (static/transcript.js) is the terminal's (fsm.logfiles.transcript), line for line.
 
 Both rebuild SMACH's log lines from the same events; the Python side is checked against the
-runtime's own printed lines (tests/test_transcript.py). Here each example is recorded as
+runtime's own printed lines (tests/unit/test_transcript.py). Here each example is recorded as
 ``fsmscope run --record`` records it, plus machines for what no example does (an Iterator, a
 Concurrence that services a preempt, with and without a 'preempted' outcome, two outcomes of the
 last state leading to one container outcome, a debugged run), and the events of each run are fed to both, in
@@ -25,7 +25,7 @@ from fsm.logfiles.transcript import Transcript
 from recording_support import EXAMPLES, FAST, cli, record
 from smach_support import Out, WaitForPreempt, concurrence, machine
 
-STATIC = Path(__file__).resolve().parents[1] / "static"
+STATIC = Path(__file__).resolve().parents[2] / "static"
 ORIGIN = "http://transcript.test"
 
 

@@ -10,7 +10,7 @@ import pytest
 from browser_support import watch
 from server.http_server import ServerThread
 from server.testing.polling import wait_for
-from test_publisher_lifecycle import publish, remote
+from publishing_support import publish, remote
 
 
 @pytest.fixture(scope="module")

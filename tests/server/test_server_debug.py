@@ -1,33 +1,11 @@
 """The debugger's REST controls against a real uvicorn (docs/debugging.md, docs/api.md)."""
 
 import threading
-import time
 
-import fsm
 import pytest
 from server.testing.polling import wait_for
 
-from server_support import client
-
-
-def looping_machine():
-    """A <-> B until ``stop`` is set; each writes its count into userdata ``n``."""
-    stop = threading.Event()
-    count = {"n": 0}
-
-    def tick(ud):
-        time.sleep(0.002)
-        count["n"] += 1
-        ud.n = count["n"]
-        return "stop" if stop.is_set() else "go"
-
-    sm = fsm.StateMachine(outcomes=["done"])
-    with sm:
-        fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
-                             {"go": "B", "stop": "done"})
-        fsm.StateMachine.add("B", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
-                             {"go": "A", "stop": "done"})
-    return sm, stop
+from server_support import client, looping_machine
 
 
 @pytest.fixture

@@ -4,44 +4,10 @@ middle of a run shows its machine disconnected, not running."""
 
 from __future__ import annotations
 
-import os
 import signal
-import subprocess
-import sys
-import textwrap
 
-from browser_support import ROOT
+from publishing_support import publish, remote
 from server.testing.polling import wait_for
-from server_support import client
-
-SCRIPT = textwrap.dedent("""
-    import sys, time
-    import fsm as smach
-    from server.publisher import Publisher
-
-    def step(ud):
-        time.sleep(float(sys.argv[3]))
-        return "go"
-
-    sm = smach.StateMachine(outcomes=["done"])
-    with sm:
-        smach.StateMachine.add("A", smach.CBState(step, outcomes=["go"]), {"go": "B"})
-        smach.StateMachine.add("B", smach.CBState(step, outcomes=["go"]), {"go": "done"})
-    smach.attach(sm, Publisher(sys.argv[1], sys.argv[2]), name="remote")
-    print("started", file=sys.stderr, flush=True)
-    sm.execute()
-""")
-
-
-def publish(tmp_path, srv, step_seconds: float) -> subprocess.Popen:
-    script = tmp_path / "publish.py"
-    script.write_text(SCRIPT)
-    return subprocess.Popen([sys.executable, str(script), srv.base_url, srv.token, str(step_seconds)], cwd=ROOT,
-                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=dict(os.environ, PYTHONPATH=str(ROOT)))
-
-
-def remote(srv) -> dict | None:
-    return next((m for m in client(srv).get("/api/machines").json() if m["name"] == "remote"), None)
 
 
 def test_a_script_that_exits_right_after_its_run_delivers_the_last_events(live_server, tmp_path):

@@ -10,8 +10,8 @@ commands land at the same simulated instants whatever the thread scheduling.
 The arm follows a :class:`JointPath` evaluated at simulated time inside the physics
 thread; :meth:`World.hold` replaces it by the current joint position.
 
-One piece (about 350 lines) because everything here touches ``MjData`` under the one lock the
-physics thread holds: episode set-up, stepping, the arm's path, the gripper and the readings.
+One piece because everything here touches ``MjData`` under the one lock the physics thread
+holds: episode set-up, stepping, the arm's path, the gripper and the readings.
 """
 
 from __future__ import annotations
@@ -20,11 +20,12 @@ import math
 import threading
 import time
 from collections import deque
-from dataclasses import dataclass
 from importlib import resources
 
 import mujoco
 import numpy as np
+
+from .joint_path import JointPath
 
 ARM_JOINTS = ["j1", "j2", "j3", "j4", "j5", "j6"]
 FINGER_JOINTS = ["finger_left", "finger_right"]
@@ -46,32 +47,6 @@ def model_path() -> str:
 
 def load_model() -> mujoco.MjModel:
     return mujoco.MjModel.from_xml_path(model_path())
-
-
-def min_jerk(s: float) -> float:
-    s = min(max(s, 0.0), 1.0)
-    return s * s * s * (10.0 - 15.0 * s + 6.0 * s * s)
-
-
-@dataclass
-class JointPath:
-    """Joint waypoints (K x 6) followed over ``duration`` s with a min-jerk time scale."""
-
-    waypoints: np.ndarray
-    t0: float
-    duration: float
-
-    def at(self, t: float) -> np.ndarray:
-        k = len(self.waypoints) - 1
-        if k == 0 or self.duration <= 0:
-            return self.waypoints[-1]
-        x = min_jerk((t - self.t0) / self.duration) * k
-        i = min(int(x), k - 1)
-        f = x - i
-        return self.waypoints[i] * (1.0 - f) + self.waypoints[i + 1] * f
-
-    def end_time(self) -> float:
-        return self.t0 + self.duration
 
 
 class WorldStopped(RuntimeError):

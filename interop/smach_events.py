@@ -24,9 +24,10 @@ in time order) become one machine's events:
 from __future__ import annotations
 
 import heapq
-from typing import Iterable, Iterator
+from typing import Any, Callable, Iterable, Iterator
 
 from fsm.observation import schema
+from fsm.observation.schema import build
 from fsm.observation.encoding import dumps, encode_userdata
 
 from . import safe_pickle
@@ -121,12 +122,13 @@ class _Machine:
         self.run: str | None = None
         self.t = 0.0
 
-    def _event(self, kind: str, path: str, fields: dict) -> dict:
+    def _event(self, make: Callable[..., dict], path: str, *fields: Any) -> dict:
+        """The next event, made by the schema's maker of its kind (``schema.build``)."""
         self.seq += 1
-        return schema.event(self.seq, self.t, self.run, self.name, kind, path, fields)
+        return make(self.seq, self.t, self.run, self.name, path, *fields)
 
     def structure(self) -> dict:
-        return self._event("structure", self.tree.root, {"root": self.tree.node(self.tree.root)})
+        return self._event(build.structure, self.tree.root, self.tree.node(self.tree.root))
 
     def status(self, m: Message) -> Iterator[dict]:
         self.t = m.t
@@ -136,7 +138,7 @@ class _Machine:
             data = safe_pickle.local_data(f["local_data"]) if f["local_data"] else {}
         except ValueError as exc:
             data = {}
-            yield self._event("log", path, {"level": "warn", "msg": "userdata not read: %s" % exc})
+            yield self._event(build.log, path, "warn", "userdata not read: %s" % exc)
         if not isinstance(data, dict):
             data = {"local_data": data}
         data = encode_userdata(data)  # compared and sent encoded: each value encoded once
@@ -165,8 +167,7 @@ class _Machine:
         initial = self.tree.initial.get(path, []) or seen
         self.active[path] = list(initial)
         self.userdata[path] = data
-        yield self._event("start", path, {"initial": initial, "active": list(initial),
-                                          "userdata": data})
+        yield self._event(build.start, path, initial, list(initial), data)
         yield from self._move(path, seen)
 
     def _move(self, path: str, now: list[str]) -> Iterator[dict]:
@@ -181,8 +182,7 @@ class _Machine:
                 yield from self._leave(path, state, None)
                 remaining = [s for s in before if s not in left[:i + 1]]
                 self.active[path] = remaining
-                yield self._event("transition", path, {"from": state, "outcome": self.tree.step(path, state, None),
-                                                       "to": None, "active": remaining})
+                yield self._event(build.transition, path, state, self.tree.step(path, state, None), None, remaining)
             self.active[path] = list(now)
             return
         source = before[0] if before else None
@@ -193,8 +193,7 @@ class _Machine:
             self.left[path] = [source]
         self.active[path] = list(now)
         if source is not None:
-            yield self._event("transition", path, {"from": source, "outcome": outcome, "to": target,
-                                                   "active": list(now)})
+            yield self._event(build.transition, path, source, outcome, target, list(now))
 
     def _leave(self, path: str, state: str, outcome: str | None) -> Iterator[dict]:
         """A state its container left: when it is a running container, it terminated (with ``outcome``,
@@ -210,18 +209,16 @@ class _Machine:
         last = self.active.pop(path) or self.left.get(path, [])
         known = [self.ended[path + "/" + s] for s in last if path + "/" + s in self.ended]
         own, state_outcome = self.tree.outcome(path, last, known)
-        fields = {"last": last, "outcome": outcome or own, "active": []}
-        self.ended[path] = fields["outcome"]
-        if state_outcome is not None:
-            fields["state_outcome"] = state_outcome
-        yield self._event("terminate", path, fields)
+        self.ended[path] = outcome = outcome or own
+        yield self._event(build.terminate, path, last, outcome, [],
+                          schema.ABSENT if state_outcome is None else state_outcome)
 
     def _userdata(self, path: str, data: dict) -> Iterator[dict]:
         old = self.userdata.get(path, {})
         changed = {k: v for k, v in data.items() if k not in old or dumps(old[k]) != dumps(v)}  # 1 is not True
         self.userdata[path] = data
         if changed:
-            yield self._event("userdata", path, {"changes": changed})
+            yield self._event(build.userdata, path, changed)
 
 
 def events(messages: Iterable[Message]) -> Iterator[dict]:

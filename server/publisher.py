@@ -150,8 +150,8 @@ class Publisher:
         return batch
 
     def _snapshots(self) -> list[dict]:
-        return [schema.event(status.last_seq, time.time(), status.run, name, "snapshot",
-                             status.root_path or "/SM_ROOT", {"status": status.to_dict()})
+        return [schema.build.snapshot(status.last_seq, time.time(), status.run, name, status.root_path or "/SM_ROOT",
+                                      status.to_dict())
                 for name, status in self._statuses.items() if status.last_seq]
 
     def _hello(self) -> str:

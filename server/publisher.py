@@ -158,8 +158,8 @@ class Publisher:
         """Which machines take controls, sent first on every connection and again after an attach."""
         self._announced = self._handles_changed
         handles = dict(self._handles)
-        return dumps({"type": "hello", "controllable": sorted(handles),
-                      "can_start": {name: handle.can_start for name, handle in handles.items()}}).decode()
+        return dumps(schema.frame.hello(sorted(handles),
+                                        {name: handle.can_start for name, handle in handles.items()})).decode()
 
     _announced = -1
 

@@ -26,7 +26,8 @@ from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, event
 from .fields import (ABSENT, MAX_DOC, MAX_NAME, MAX_PATH, MAX_SEQ, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES,
                      MAX_VALUE_DEPTH, VERSION, Field, Kind, Type, argument)
 from .ids import ID_ESCAPES, ID_PREFIXES, container_id, edge_id, id_text, outcome_id, state_id
-from .messages import MESSAGES, Message, frame, list_frame
+from .messages import (DEADMAN_ACTIONS, HISTORY_FIELDS, HISTORY_LIMIT, MAX_PACE_MS, MESSAGES, Message,
+                       encoded_history, frame, frame_problem, list_frame, with_history)
 from .status import (BREAKPOINT, BREAKPOINT_FIELDS, CONTAINER_STATUS_FIELDS, DEBUG_ACTIONS, DEBUG_STATUS_FIELDS, HOLD_FIELDS,
                      LAST_TRANSITION_FIELDS, POSE_FIELDS, PREEMPT_FIELDS, STATUS, STATUS_FIELDS)
 from .tree import (CONTAINER_FIELDS, CONTAINER_TYPES, KIND_FIELDS, NODE, NODE_FIELDS, TRANSITION_FIELDS,
@@ -38,7 +39,8 @@ __all__ = [
     "MAX_DOC", "MAX_NAME", "MAX_PATH", "MAX_SEQ", "MAX_STRUCTURE_DEPTH", "MAX_STRUCTURE_NODES", "MAX_VALUE_DEPTH",
     "VERSION", "Field", "Kind", "Type",
     "ID_ESCAPES", "ID_PREFIXES", "container_id", "edge_id", "id_text", "outcome_id", "state_id",
-    "MESSAGES", "Message", "frame", "list_frame",
+    "DEADMAN_ACTIONS", "HISTORY_FIELDS", "HISTORY_LIMIT", "MAX_PACE_MS", "MESSAGES", "Message", "encoded_history", "frame",
+    "frame_problem", "list_frame", "with_history",
     "BREAKPOINT", "BREAKPOINT_FIELDS", "CONTAINER_STATUS_FIELDS", "DEBUG_ACTIONS", "DEBUG_STATUS_FIELDS", "HOLD_FIELDS",
     "LAST_TRANSITION_FIELDS", "POSE_FIELDS", "PREEMPT_FIELDS", "STATUS", "STATUS_FIELDS",
     "CONTAINER_FIELDS", "CONTAINER_TYPES", "KIND_FIELDS", "NODE", "NODE_FIELDS", "TRANSITION_FIELDS",

@@ -10,16 +10,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from types import SimpleNamespace
+from typing import Any
 
 from .events import EVENT
 from .fields import (BOOL, JSON, LIST_STR, NAME, NUMBER, OBJECT, SEQ, STR, Field, Type, fields_problem, list_of,
                      maker, object_of, one_of, simple)
 from .status import BREAKPOINT, STATUS
 
+MAX_PACE_MS = 10_000  # the slowest pace a page may ask for
+DEADMAN_ACTIONS = ("pause", "preempt", "none")  # what a publisher does itself when an operator's link is gone
+HISTORY_LIMIT = 5000  # events of the current run a new page is sent with its first snapshot, at most
 COUNT = simple("an integer of 0 or more", (int,), lambda v: v >= 0)
-PACE_MS = simple("an integer from 0 to 10000", (int,), lambda v: 0 <= v <= 10000)
+PACE_MS = simple("an integer from 0 to %d" % MAX_PACE_MS, (int,), lambda v: 0 <= v <= MAX_PACE_MS)
 HISTORY_FIELDS = (Field("complete", BOOL, doc="whether it reaches back to the run's first event"),
-                  Field("events", list_of(EVENT, "a list of events"), doc="oldest first, at most 5000"))
+                  Field("events", list_of(EVENT, "a list of events"), doc="oldest first, at most %d" % HISTORY_LIMIT))
 
 
 @dataclass(frozen=True)
@@ -65,7 +69,7 @@ MESSAGES: dict[str, Message] = {m.name: m for m in (
               doc="breakpoints, get-breakpoints: the whole set"))),
     Message("lease", "server to publisher", "The operator lease of one of its machines was taken, released or "
             "lapsed.", (Field("machine", NAME), Field("held", BOOL), Field("after", NUMBER, doc="seconds"),
-                        Field("action", one_of("pause", "preempt", "none"),
+                        Field("action", one_of(*DEADMAN_ACTIONS),
                               doc="what the publisher does itself when its link is gone that long"))),
     Message("rejected", "server to publisher", "An event refused at the door.", (
         Field("reason", STR, doc="what is wrong, in words"), Field("machine", JSON, doc="the event's, if any"),
@@ -76,8 +80,31 @@ MESSAGES: dict[str, Message] = {m.name: m for m in (
 frame = SimpleNamespace(**{name: maker(name, (("type", repr(name)),), m.fields, m.doc) for name, m in MESSAGES.items()})
 
 
+def frame_problem(message: Any) -> str | None:
+    """What is wrong with a frame, in words (None when it fits its definition)."""
+    if type(message) is not dict:
+        return "a frame must be an object"
+    spec = MESSAGES.get(message.get("type")) if type(message.get("type")) is str else None
+    if spec is None:
+        return "unknown frame type %r" % (message.get("type"),)
+    return fields_problem(message, spec.fields, spec.name)
+
+
+# The fan-out encodes each event once and each snapshot once, and splices what it already encoded into
+# frames: these put the encoded parts where the definitions above say.
+
 def list_frame(name: str) -> tuple[bytes, bytes]:
     """The text before and after the already-encoded items of a frame whose one field is a list
     (``events``): the fan-out joins each client's batch between them instead of encoding it again."""
     (field,) = MESSAGES[name].fields
     return b'{"type":"%s","%s":[' % (name.encode(), field.name.encode()), b"]}"
+
+
+def encoded_history(complete: bool, events: list[bytes]) -> bytes:
+    """A snapshot's ``history`` (HISTORY_FIELDS) from already-encoded events."""
+    return b'{"complete":%s,"events":[%s]}' % (b"true" if complete else b"false", b",".join(events))
+
+
+def with_history(snapshot: str, history: bytes) -> str:
+    """An encoded snapshot frame (whose last field is ``last_seq``) with its optional ``history`` added."""
+    return snapshot[:-1] + ',"history":' + history.decode() + "}"

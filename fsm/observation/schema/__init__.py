@@ -24,7 +24,7 @@ Everything is importable from ``fsm.observation.schema`` itself. Standard librar
 
 from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, event
 from .fields import (ABSENT, MAX_DOC, MAX_NAME, MAX_PATH, MAX_SEQ, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES,
-                     MAX_VALUE_DEPTH, VERSION, Field, Kind, Type, argument)
+                     MAX_VALUE_DEPTH, SHAPES, VERSION, Field, Kind, Type, argument)
 from .ids import ID_ESCAPES, ID_PREFIXES, container_id, edge_id, id_text, outcome_id, state_id
 from .messages import (DEADMAN_ACTIONS, HISTORY_FIELDS, HISTORY_LIMIT, MAX_PACE_MS, MESSAGES, Message,
                        encoded_history, frame, frame_problem, list_frame, with_history)
@@ -37,7 +37,7 @@ from .validation import DEBUG_NEEDS, validate
 __all__ = [
     "ABSENT", "ENVELOPE", "EVENT", "KINDS", "SOURCES", "argument", "build", "event",
     "MAX_DOC", "MAX_NAME", "MAX_PATH", "MAX_SEQ", "MAX_STRUCTURE_DEPTH", "MAX_STRUCTURE_NODES", "MAX_VALUE_DEPTH",
-    "VERSION", "Field", "Kind", "Type",
+    "SHAPES", "VERSION", "Field", "Kind", "Type",
     "ID_ESCAPES", "ID_PREFIXES", "container_id", "edge_id", "id_text", "outcome_id", "state_id",
     "DEADMAN_ACTIONS", "HISTORY_FIELDS", "HISTORY_LIMIT", "MAX_PACE_MS", "MESSAGES", "Message", "encoded_history", "frame",
     "frame_problem", "list_frame", "with_history",

@@ -13,7 +13,7 @@ from types import SimpleNamespace
 
 from .fields import (JSON, LIST_STR, MAP_OPT_STR, MAP_BODY_POSE, MAP_NUMBER, NAME, NUMBER, OBJECT, OPT_STR, PATH,
                      SEQ, STR, VERSION, Field, Kind, Type, fields_problem, list_of, maker, nullable, one_of, simple)
-from .status import BREAKPOINT, DEBUG_ACTIONS, STATUS
+from .status import AT, BREAKPOINT, DEBUG_ACTIONS, DEBUG_MODES, STATUS
 from .tree import NODE
 
 # Where a served machine's events come from (whether it takes controls is /api/machines' `controllable`).
@@ -30,7 +30,7 @@ ENVELOPE = (
     Field("kind", STR, doc="one of the kinds below"),
     Field("path", PATH, doc="the container (for feedback: the state) the event is about"),
 )
-EVENT = Type("an event (docs/events.md)", lambda v: fields_problem(v, ENVELOPE))
+EVENT = Type("an event (docs/events.md)", lambda v: fields_problem(v, ENVELOPE), js="FsmEvent")
 
 KINDS: dict[str, Kind] = {k.name: k for k in (
     Kind("structure", "The whole container tree.", (
@@ -70,11 +70,11 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
     Kind("debug", "The debugger (fsm.debugging) changed mode, held or released a transition, forced an outcome "
                   "or replaced its breakpoints; path is the container's (the root's for mode and breakpoints).", (
         Field("action", one_of(*DEBUG_ACTIONS)),
-        Field("mode", one_of("run", "pause", "step"), required=False, doc="mode: what it is now"),
+        Field("mode", one_of(*DEBUG_MODES), required=False, doc="mode: what it is now"),
         Field("level", nullable(PATH), required=False, doc="mode step: the container whose next transition "
                                                             "ends the step (null: the next anywhere)"),
         Field("state", STR, required=False, doc="hold, release, forced: the child's label"),
-        Field("at", one_of("before", "after"), required=False,
+        Field("at", AT, required=False,
               doc="hold, release: before the child runs, or after it returned (the transition held)"),
         Field("outcome", OPT_STR, required=False, doc="hold: the outcome to be taken; release, forced: the one taken"),
         Field("returned", OPT_STR, required=False, doc="forced: what the state returned (null: it did not run)"),

@@ -24,12 +24,17 @@ Problem = Callable[[Any], "str | None"]  # a type check: None when the value fit
 @dataclass(frozen=True)
 class Type:
     """A field's type: its name in the docs, the check that says what is wrong (or None), and a
-    fast test for the common case: the exact Python types allowed (None: any), then ``ok(value)``."""
+    fast test for the common case: the exact Python types allowed (None: any), then ``ok(value)``.
+    ``js``: its type in the browser's JSDoc typedefs; ``null``: null is allowed; ``shape``: the
+    fields of an object of a shape of its own (its typedef is named ``js``)."""
 
     name: str
     check: Problem
     types: tuple | None = None
     ok: Callable[[Any], bool] | None = None
+    js: str = "*"
+    null: bool = False
+    shape: tuple[Field, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -52,11 +57,14 @@ def _what(value: Any) -> str:
             list: "a list", dict: "an object"}.get(type(value), type(value).__name__)
 
 
+_JS = {str: "string", bool: "boolean", int: "number", float: "number", list: "Array<*>", dict: "Object<string, *>"}
+
+
 def simple(name: str, types: tuple, ok: Callable[[Any], bool] | None = None) -> Type:
     """A type that is right when the value is of one of ``types`` and passes ``ok``."""
     def check(v: Any) -> str | None:
         return None if type(v) in types and (ok is None or ok(v)) else "must be %s, not %s" % (name, _what(v))
-    return Type(name, check, types, ok)
+    return Type(name, check, types, ok, js="|".join(dict.fromkeys(_JS[t] for t in types)))
 
 
 def nullable(t: Type) -> Type:
@@ -67,7 +75,8 @@ def nullable(t: Type) -> Type:
         return problem and problem.replace("must be " + t.name, "must be " + name, 1)
 
     ok = None if t.ok is None else (lambda v, inner=t.ok: v is None or inner(v))
-    return Type(name, check, None if t.types is None else t.types + (type(None),), ok)
+    return Type(name, check, None if t.types is None else t.types + (type(None),), ok, js="(%s|null)" % t.js,
+                null=True, shape=t.shape)
 
 
 STR = simple("a string", (str,))
@@ -82,7 +91,8 @@ OPT_NUMBER = nullable(NUMBER)
 
 def one_of(*values: str) -> Type:
     shown = ", ".join("'%s'" % v for v in values)
-    return simple("one of " + shown, (str,), lambda v: v in values)
+    t = simple("one of " + shown, (str,), lambda v: v in values)
+    return Type(t.name, t.check, t.types, t.ok, js="(%s)" % "|".join('"%s"' % v for v in values))
 
 
 def list_of(item: Type, name: str, ok: Callable[[Any], bool] | None = None) -> Type:
@@ -94,7 +104,7 @@ def list_of(item: Type, name: str, ok: Callable[[Any], bool] | None = None) -> T
             if problem:
                 return _join("[%d]" % i, problem)
         return None
-    return Type(name, check, (list,), ok or (lambda v: check(v) is None))
+    return Type(name, check, (list,), ok or (lambda v: check(v) is None), js="Array<%s>" % item.js)
 
 
 def object_of(value: Type, name: str) -> Type:
@@ -106,7 +116,7 @@ def object_of(value: Type, name: str) -> Type:
             if problem:
                 return _join("[%r]" % (k,), problem)
         return None
-    return Type(name, check, (dict,), lambda v: check(v) is None)
+    return Type(name, check, (dict,), lambda v: check(v) is None, js="Object<string, %s>" % value.js)
 
 
 def _all_str(v: list) -> bool:
@@ -139,7 +149,8 @@ def _json_depth_problem(v: Any, depth: int) -> str | None:
 
 JSON = Type("any JSON value", lambda v: _json_depth_problem(v, 0), None, lambda v: _json_depth_problem(v, 0) is None)
 OBJECT = Type("an object", lambda v: ("must be an object, not %s" % _what(v)) if type(v) is not dict
-              else _json_depth_problem(v, 0), (dict,), lambda v: _json_depth_problem(v, 0) is None)
+              else _json_depth_problem(v, 0), (dict,), lambda v: _json_depth_problem(v, 0) is None,
+              js="Object<string, *>")
 LIST_STR = list_of(STR, "a list of strings", _all_str)
 MAP_STR = object_of(STR, "an object of strings")
 MAP_OPT_STR = object_of(OPT_STR, "an object of strings or nulls")
@@ -150,11 +161,23 @@ def _sized(t: Type, n: int) -> Type:
     """``t`` (a list type) holding exactly ``n`` items."""
     def check(v: Any) -> str | None:
         return t.check(v) or (None if len(v) == n else "must hold %d items, not %d" % (n, len(v)))
-    return Type(t.name, check, t.types, lambda v: len(v) == n and t.ok(v))
+    return Type(t.name, check, t.types, lambda v: len(v) == n and t.ok(v), js=t.js)
 
 
 BODY_POSE = _sized(list_of(NUMBER, "a list of 7 finite numbers (x, y, z, qw, qx, qy, qz)"), 7)
 MAP_BODY_POSE = object_of(BODY_POSE, "an object of body poses")
+
+
+# Every shape by its typedef's name (static/schema.js has one typedef per shape).
+SHAPES: dict[str, Type] = {}
+
+
+def shape(name: str, js: str, fields: tuple[Field, ...], check: Problem | None = None) -> Type:
+    """An object of ``fields`` (extra fields allowed; ``check``: a check of its own instead), ``js``
+    the name of its typedef in the browser."""
+    t = Type(name, check or (lambda v: fields_problem(v, fields)), js=js, shape=fields)
+    SHAPES[js] = t
+    return t
 
 
 def _join(where: str, problem: str) -> str:

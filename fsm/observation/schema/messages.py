@@ -13,8 +13,8 @@ from types import SimpleNamespace
 from typing import Any
 
 from .events import EVENT
-from .fields import (BOOL, JSON, LIST_STR, NAME, NUMBER, OBJECT, SEQ, STR, Field, Type, fields_problem, list_of,
-                     maker, object_of, one_of, simple)
+from .fields import (BOOL, JSON, LIST_STR, NAME, NUMBER, OBJECT, SEQ, STR, Field, fields_problem, list_of,
+                     maker, object_of, one_of, shape, simple)
 from .status import BREAKPOINT, STATUS
 
 MAX_PACE_MS = 10_000  # the slowest pace a page may ask for
@@ -41,7 +41,7 @@ MESSAGES: dict[str, Message] = {m.name: m for m in (
             "resumes), and again after missed.", (
                 Field("status", STATUS, doc="the machine's status with its structure (below)"),
                 Field("last_seq", SEQ, doc="the seq of the last event the status includes"),
-                Field("history", Type("a history (below)", lambda v: fields_problem(v, HISTORY_FIELDS)),
+                Field("history", shape("a history (below)", "History", HISTORY_FIELDS),
                       required=False, doc="a new connection's only: the current run's events up to last_seq, "
                                           "for the log (already in the status: not to be applied again)"))),
     Message("events", "server to page", "Events in seq order: one per frame while the page keeps up, every "

@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from .fields import (BOOL, LIST_STR, MAP_STR, MAX_DOC, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES, OPT_STR, PATH, STR,
-                     Field, Type, fields_problem, list_of, object_of, simple)
+                     Field, Type, fields_problem, list_of, object_of, shape, simple)
 
 # Which of SMACH's containers a structure node is: its ``type`` when it is one of these, else (a
 # user's subclass) the kind whose own field it carries, else a state machine.
@@ -37,9 +37,11 @@ NODE_FIELDS = (
                                           "absent when the class has none or is one of fsm's own" % MAX_DOC),
 )
 CONTAINER_FIELDS = (
-    Field("initial", LIST_STR, doc="initial states"), Field("transitions", list_of(Type("a transition", lambda t: fields_problem(
-        t, TRANSITION_FIELDS)), "a list of transitions"), doc="its edges (below)"),
-    Field("children", simple("a list", (list,)), doc="nodes, in add order"),
+    Field("initial", LIST_STR, doc="initial states"),
+    Field("transitions", list_of(shape("a transition", "Transition", TRANSITION_FIELDS), "a list of transitions"),
+          doc="its edges (below)"),
+    Field("children", Type("a list", simple("a list", (list,)).check, (list,), js="Array<StructureNode>"),
+          doc="nodes, in add order"),
     Field("default_outcome", OPT_STR, required=False, doc="a Concurrence's"),
     Field("outcome_map", object_of(MAP_STR, "an object of objects of strings"), required=False,
           doc="a Concurrence's {container outcome: {child: outcome}}"),
@@ -77,4 +79,6 @@ def node_problem(node: Any, path: str | None = None) -> str | None:
     return walk(node, path, 0)
 
 
-NODE = Type("a structure node (below)", lambda v: node_problem(v))
+NODE = shape("a structure node (below)", "StructureNode",
+             NODE_FIELDS + tuple(Field(f.name, f.type, False, "a container's: " + f.doc) for f in CONTAINER_FIELDS),
+             lambda v: node_problem(v))

@@ -23,13 +23,16 @@ Everything is importable from ``fsm.observation.schema`` itself. Standard librar
 """
 
 from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, event
-from .fields import (ABSENT, MAX_DOC, MAX_NAME, MAX_PATH, MAX_SEQ, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES,
-                     MAX_VALUE_DEPTH, SHAPES, VERSION, Field, Kind, Type, argument)
+from .fields import (ABSENT, BODY_POSE, BOOL, JSON, LIST_STR, MAP_BODY_POSE, MAP_NUMBER, MAP_OPT_STR, MAP_STR,
+                     MAX_DOC, MAX_NAME, MAX_PATH, MAX_SEQ, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES, MAX_VALUE_DEPTH,
+                     NAME, NUMBER, OBJECT, OPT_NUMBER, OPT_STR, PATH, SEQ, SHAPES, STR, VERSION, Field, Kind, Type,
+                     argument)
 from .ids import ID_ESCAPES, ID_PREFIXES, container_id, edge_id, id_text, outcome_id, state_id
 from .messages import (DEADMAN_ACTIONS, HISTORY_FIELDS, HISTORY_LIMIT, MAX_PACE_MS, MESSAGES, Message,
                        encoded_history, frame, frame_problem, list_frame, with_history)
-from .status import (BREAKPOINT, BREAKPOINT_FIELDS, CONTAINER_STATUS_FIELDS, DEBUG_ACTIONS, DEBUG_STATUS_FIELDS, HOLD_FIELDS,
-                     LAST_TRANSITION_FIELDS, POSE_FIELDS, PREEMPT_FIELDS, STATUS, STATUS_FIELDS)
+from .status import (AT, BREAKPOINT, BREAKPOINT_FIELDS, CONTAINER_STATUS_FIELDS, DEBUG_ACTIONS, DEBUG_MODES,
+                     DEBUG_STATUS_FIELDS, HOLD_FIELDS, LAST_TRANSITION_FIELDS, POSE_FIELDS, POSITIONS, PREEMPT_FIELDS,
+                     STATUS, STATUS_FIELDS)
 from .tree import (CONTAINER_FIELDS, CONTAINER_TYPES, KIND_FIELDS, NODE, NODE_FIELDS, TRANSITION_FIELDS,
                    container_kind, node_problem)
 from .validation import DEBUG_NEEDS, validate
@@ -37,12 +40,14 @@ from .validation import DEBUG_NEEDS, validate
 __all__ = [
     "ABSENT", "ENVELOPE", "EVENT", "KINDS", "SOURCES", "argument", "build", "event",
     "MAX_DOC", "MAX_NAME", "MAX_PATH", "MAX_SEQ", "MAX_STRUCTURE_DEPTH", "MAX_STRUCTURE_NODES", "MAX_VALUE_DEPTH",
-    "SHAPES", "VERSION", "Field", "Kind", "Type",
+    "SHAPES", "VERSION", "Field", "Kind", "Type", "BODY_POSE", "BOOL", "JSON", "LIST_STR", "MAP_BODY_POSE",
+    "MAP_NUMBER", "MAP_OPT_STR", "MAP_STR", "NAME", "NUMBER", "OBJECT", "OPT_NUMBER", "OPT_STR", "PATH", "SEQ", "STR",
     "ID_ESCAPES", "ID_PREFIXES", "container_id", "edge_id", "id_text", "outcome_id", "state_id",
-    "DEADMAN_ACTIONS", "HISTORY_FIELDS", "HISTORY_LIMIT", "MAX_PACE_MS", "MESSAGES", "Message", "encoded_history", "frame",
-    "frame_problem", "list_frame", "with_history",
-    "BREAKPOINT", "BREAKPOINT_FIELDS", "CONTAINER_STATUS_FIELDS", "DEBUG_ACTIONS", "DEBUG_STATUS_FIELDS", "HOLD_FIELDS",
-    "LAST_TRANSITION_FIELDS", "POSE_FIELDS", "PREEMPT_FIELDS", "STATUS", "STATUS_FIELDS",
+    "DEADMAN_ACTIONS", "HISTORY_FIELDS", "HISTORY_LIMIT", "MAX_PACE_MS", "MESSAGES", "Message", "encoded_history",
+    "frame", "frame_problem", "list_frame", "with_history",
+    "AT", "BREAKPOINT", "BREAKPOINT_FIELDS", "CONTAINER_STATUS_FIELDS", "DEBUG_ACTIONS", "DEBUG_MODES",
+    "DEBUG_STATUS_FIELDS", "HOLD_FIELDS", "LAST_TRANSITION_FIELDS", "POSE_FIELDS", "POSITIONS", "PREEMPT_FIELDS",
+    "STATUS", "STATUS_FIELDS",
     "CONTAINER_FIELDS", "CONTAINER_TYPES", "KIND_FIELDS", "NODE", "NODE_FIELDS", "TRANSITION_FIELDS",
     "container_kind", "node_problem", "DEBUG_NEEDS", "validate",
 ]

@@ -82,7 +82,8 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
         Field("detail", STR, required=False, doc="hold: in words ('hit breakpoint before PICK/CLOSE when ...')"),
         Field("by", OPT_STR, required=False, doc="mode, forced, breakpoints: who asked; release: what ended the "
                                                   "hold (resume, step, force, preempt, shutdown, detach)"),
-        Field("breakpoints", list_of(BREAKPOINT, "a list of breakpoints"), required=False, doc="breakpoints: the whole set"))),
+        Field("breakpoints", list_of(BREAKPOINT, "a list of breakpoints"), required=False,
+              doc="breakpoints: the whole set"))),
     Kind("pose", "The robot's pose, sampled at the rate the 3D view draws it (the demo: 30 Hz).", (
         Field("joints", MAP_NUMBER, doc="joint positions by joint name (radians, metres)"),
         Field("bodies", MAP_BODY_POSE, required=False,

@@ -30,7 +30,8 @@ BREAKPOINT_FIELDS = (Field("state", PATH, doc="the state's path"), Field("at", A
                      Field("when", OPT_STR, doc="a condition over the container's userdata"))
 BREAKPOINT = shape("a breakpoint", "Breakpoint", BREAKPOINT_FIELDS)
 HOLD_FIELDS = (Field("path", PATH, doc="the holding container's"), Field("state", STR), Field("at", AT),
-               Field("outcome", OPT_STR), Field("reason", STR), Field("detail", STR), Field("seq", SEQ, doc="the hold event's"))
+               Field("outcome", OPT_STR), Field("reason", STR), Field("detail", STR),
+               Field("seq", SEQ, doc="the hold event's"))
 DEBUG_STATUS_FIELDS = (Field("mode", one_of(*DEBUG_MODES)), Field("level", nullable(PATH)),
                        Field("holds", list_of(shape("a hold", "Hold", HOLD_FIELDS), "a list of holds"),
                              doc="{path, state, at, outcome, reason, detail, seq}"),

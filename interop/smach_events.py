@@ -73,7 +73,7 @@ class _Tree:
         s = self.structures.get(path)
         if s is None:
             return []
-        return [{"from": f, "outcome": o, "to": None if t == NONE else t}
+        return [schema.edge(f, o, None if t == NONE else t)
                 for o, f, t in zip(s["internal_outcomes"], s["outcomes_from"], s["outcomes_to"])]
 
     def outcomes(self, path: str) -> list[str]:
@@ -85,13 +85,14 @@ class _Tree:
         return list(s["children"]) if s else list(self.named.get(path, []))
 
     def node(self, path: str) -> dict:
-        base = {"label": _label(path), "path": path, "input_keys": [], "output_keys": [], "remapping": {}}
         if path not in self.paths:
             outcomes = sorted({e["outcome"] for e in self.edges(_parent(path)) if e["from"] == _label(path)})
-            return {**base, "type": "State", "container": False, "outcomes": outcomes}
-        return {**base, "type": "Concurrence" if path in self.concurrent else "StateMachine", "container": True,
-                "outcomes": self.outcomes(path), "initial": self.initial.get(path, []),
-                "transitions": self.edges(path), "children": [self.node(path + "/" + c) for c in self.children(path)]}
+            return schema.node(_label(path), path, "State", False, outcomes, [], [], {})
+        node = schema.node(_label(path), path, "Concurrence" if path in self.concurrent else "StateMachine", True,
+                           self.outcomes(path), [], [], {})
+        node.update(schema.container_fields(self.initial.get(path, []), self.edges(path),
+                                            [self.node(path + "/" + c) for c in self.children(path)]))
+        return node
 
     def outcome(self, path: str, last: list[str], returned: list[str]) -> tuple[str, str | None]:
         """(the container's outcome, its last state's) from the edges of its last states into its

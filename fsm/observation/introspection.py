@@ -22,6 +22,7 @@ from typing import Any, Callable
 from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
 from .encoding import encode_userdata
+from . import schema
 from .schema import ABSENT, MAX_DOC, build, event as _event
 from .structure import children, is_container
 
@@ -154,25 +155,23 @@ def class_doc(cls: type) -> str | None:
 def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict) -> dict:
     state._reporter = rep
     state._path = path
-    node = {"label": label, "path": path, "type": type(state).__name__,
-            "container": is_container(state),
-            "outcomes": sorted(map(str, state.get_registered_outcomes())),
-            "input_keys": sorted(map(str, state.get_registered_input_keys())),
-            "output_keys": sorted(map(str, state.get_registered_output_keys())),
-            "remapping": {str(k): str(v) for k, v in (remapping or {}).items()}}
     doc = class_doc(type(state))
-    if doc is not None:
-        node["doc"] = doc
-    if not node["container"]:
+    container = is_container(state)
+    node = schema.node(label, path, type(state).__name__, container, sorted(map(str, state.get_registered_outcomes())),
+                       sorted(map(str, state.get_registered_input_keys())),
+                       sorted(map(str, state.get_registered_output_keys())),
+                       {str(k): str(v) for k, v in (remapping or {}).items()}, ABSENT if doc is None else doc)
+    if not container:
         return node
     if state.userdata._dirty is None:
         state.userdata.track_writes()
     remappings = getattr(state, "_remappings", {})
-    node["initial"] = [str(s) for s in state.get_initial_states()]
-    node["children"] = [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
-                        for lbl, child in children(state).items()]
-    node["transitions"] = [{"from": str(frm), "outcome": str(outcome), "to": None if to is None else str(to)}
-                           for outcome, frm, to in state.get_internal_edges()]
+    node.update(schema.container_fields(
+        [str(s) for s in state.get_initial_states()],
+        [schema.edge(str(frm), str(outcome), None if to is None else str(to))
+         for outcome, frm, to in state.get_internal_edges()],
+        [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
+         for lbl, child in children(state).items()]))
     node.update(state._introspection_info())
     return node
 

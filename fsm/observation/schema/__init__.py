@@ -3,7 +3,7 @@
 One package, one module per concept:
 
 * ``fields``: the vocabulary (limits, ``Type``, ``Field``, ``Kind``, the types shapes are made of);
-* ``tree``: the structure tree a ``structure`` event carries;
+* ``tree``: the structure tree a ``structure`` event carries, and the makers of its parts;
 * ``status``: a machine's status (``fsm.observation.status.Status.to_dict()``), its debugger's state,
   holds and breakpoints;
 * ``events``: the envelope, each kind's fields, and ``build``, the one way each kind is made;
@@ -34,7 +34,7 @@ from .status import (AT, BREAKPOINT, BREAKPOINT_FIELDS, CONTAINER_STATUS_FIELDS,
                      DEBUG_STATUS_FIELDS, HOLD_FIELDS, LAST_TRANSITION_FIELDS, POSE_FIELDS, POSITIONS, PREEMPT_FIELDS,
                      STATUS, STATUS_FIELDS)
 from .tree import (CONTAINER_FIELDS, CONTAINER_TYPES, KIND_FIELDS, NODE, NODE_FIELDS, TRANSITION_FIELDS,
-                   container_kind, node_problem)
+                   container_fields, container_kind, edge, node, node_problem)
 from .validation import DEBUG_NEEDS, validate
 
 __all__ = [
@@ -49,5 +49,5 @@ __all__ = [
     "DEBUG_STATUS_FIELDS", "HOLD_FIELDS", "LAST_TRANSITION_FIELDS", "POSE_FIELDS", "POSITIONS", "PREEMPT_FIELDS",
     "STATUS", "STATUS_FIELDS",
     "CONTAINER_FIELDS", "CONTAINER_TYPES", "KIND_FIELDS", "NODE", "NODE_FIELDS", "TRANSITION_FIELDS",
-    "container_kind", "node_problem", "DEBUG_NEEDS", "validate",
+    "container_fields", "container_kind", "edge", "node", "node_problem", "DEBUG_NEEDS", "validate",
 ]

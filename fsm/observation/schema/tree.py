@@ -6,7 +6,7 @@ from __future__ import annotations
 from typing import Any
 
 from .fields import (BOOL, LIST_STR, MAP_STR, MAX_DOC, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES, OPT_STR, PATH, STR,
-                     Field, Type, fields_problem, list_of, object_of, shape, simple)
+                     Field, Type, fields_problem, list_of, maker, object_of, shape, simple)
 
 # Which of SMACH's containers a structure node is: its ``type`` when it is one of these, else (a
 # user's subclass) the kind whose own field it carries, else a state machine.
@@ -82,3 +82,10 @@ def node_problem(node: Any, path: str | None = None) -> str | None:
 NODE = shape("a structure node (below)", "StructureNode",
              NODE_FIELDS + tuple(Field(f.name, f.type, False, "a container's: " + f.doc) for f in CONTAINER_FIELDS),
              lambda v: node_problem(v))
+
+
+# The makers of a structure tree's parts, the fields in their order (optional ones by keyword, left out when
+# not given): a node, a container's own fields (added to its node), one of its edges.
+node = maker("node", (), NODE_FIELDS, "A structure node: every state's fields.")
+container_fields = maker("container_fields", (), CONTAINER_FIELDS, "A container node's own fields.")
+edge = maker("edge", (), TRANSITION_FIELDS, "One of a container's edges.")

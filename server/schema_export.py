@@ -55,7 +55,7 @@ def javascript() -> str:
     """The text of static/schema.js."""
     escapes = {chr(code): text for code, text in schema.ID_ESCAPES.items()}
     pattern = "".join("\\u%04x" % ord(c) for c in escapes)
-    return """// Generated from fsm/observation/schema.py by `python -m server.schema_export`: do not edit by hand
+    return """// Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
 // (tests/test_schema_export.py fails when this file and the Python definition differ).
 
 /** The event schema version this page reads. */

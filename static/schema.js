@@ -1,4 +1,4 @@
-// Generated from fsm/observation/schema.py by `python -m server.schema_export`: do not edit by hand
+// Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
 // (tests/test_schema_export.py fails when this file and the Python definition differ).
 
 /** The event schema version this page reads. */

@@ -21,8 +21,8 @@ from typing import Any, Callable
 
 from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
-from .encoding import encode_userdata
 from . import schema
+from .encoding import encode_userdata
 from .schema import ABSENT, MAX_DOC, build, event as _event
 from .structure import children, is_container
 

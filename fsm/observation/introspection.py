@@ -23,7 +23,7 @@ from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
 from . import schema
 from .encoding import encode_userdata
-from .schema import ABSENT, MAX_DOC, build, event as _event
+from .schema import ABSENT, MAX_DOC, build
 from .structure import children, is_container
 
 DEFAULT_ROOT_PATH = "/SM_ROOT"
@@ -55,7 +55,7 @@ class Reporter:
     def add_observer(self, observer: Observer) -> None:
         """An observer with an ``attached(reporter)`` method is then given this reporter: one that acts
         on the machine too (a publisher that takes controls from afar) reaches it as ``reporter.root``."""
-        # Replaced, never mutated: emit iterates the list it read without the lock.
+        # Replaced, never mutated: send iterates the list it read without the lock.
         self._observers = self._observers + [observer]
         self._described_at = -1  # the newcomer has not seen the structure
         _set_listening(self, True)
@@ -69,12 +69,9 @@ class Reporter:
         if not self._observers:
             _set_listening(self, False)
 
-    def emit(self, kind: str, path: str | None, fields: dict | None = None) -> dict | None:
-        """Stamp and deliver one event of any kind from its fields; returns it (None when nobody listens)."""
-        return self.send(_any_kind, path, kind, fields)
-
     def send(self, make: Callable[..., dict], path: str | None, *args: Any) -> dict | None:
-        """Stamp ``make(seq, t, run, machine, path, *args)`` and deliver it; returns it (None when nobody listens)."""
+        """Stamp ``make(seq, t, run, machine, path, *args)`` (a maker of ``schema.build``) and deliver it;
+        returns it (None when nobody listens)."""
         observers = self._observers
         if not observers:
             return None
@@ -208,10 +205,6 @@ def _set_listening(rep: Reporter, on: bool) -> None:
     with _listening_lock:
         (_listening.add if on else _listening.discard)(rep)
         log.listener = _on_log if _listening else None
-
-
-def _any_kind(seq: int, t: float, run: str | None, machine: str, path: str, kind: str, fields: dict | None) -> dict:
-    return _event(seq, t, run, machine, kind, path, fields)
 
 
 # The makers of the kinds core reports, bound once.

@@ -25,6 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 import fsm  # noqa: E402
 from fsm.observation.encoding import dumps  # noqa: E402
+from fsm.observation.schema import build  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
 from server.testing.clients import stalled_stream  # noqa: E402  (the stalled browser of the tests)
 
@@ -92,8 +93,8 @@ def emit_paced(rep, path, n, rate):
             delay = start + i / rate - time.perf_counter()
             if delay > 0:
                 time.sleep(delay)
-        rep.emit("log", path, {"level": "info", "msg": "tick %d" % i})
-    rep.emit("log", path, {"level": "info", "msg": "end"})
+        rep.send(build.log, path, "info", "tick %d" % i)
+    rep.send(build.log, path, "info", "end")
 
 
 def make_machine():

@@ -132,8 +132,8 @@ class _Machine:
         lock, current = self.shared.get(self.name) or (self.lock, lambda: self.status)
         with lock:
             status = current()
-            snapshot = schema.event(status.last_seq, time.time(), status.run, self.name, "snapshot",
-                                    status.root_path or "/SM_ROOT", {"status": dict(status.to_dict(), machine=self.name)})
+            snapshot = schema.build.snapshot(status.last_seq, time.time(), status.run, self.name,
+                                             status.root_path or "/SM_ROOT", dict(status.to_dict(), machine=self.name))
         query.reply(query.key_expr, dumps({"snapshot": snapshot, "controls": self.controls.offer(self.name),
                                            "origin": self.origin}))
 

@@ -24,9 +24,10 @@ in time order) become one machine's events:
 from __future__ import annotations
 
 import heapq
-from typing import Iterable, Iterator
+from typing import Any, Callable, Iterable, Iterator
 
 from fsm.observation import schema
+from fsm.observation.schema import build
 from fsm.observation.encoding import dumps, encode_userdata
 
 from . import safe_pickle
@@ -72,7 +73,7 @@ class _Tree:
         s = self.structures.get(path)
         if s is None:
             return []
-        return [{"from": f, "outcome": o, "to": None if t == NONE else t}
+        return [schema.edge(f, o, None if t == NONE else t)
                 for o, f, t in zip(s["internal_outcomes"], s["outcomes_from"], s["outcomes_to"])]
 
     def outcomes(self, path: str) -> list[str]:
@@ -84,13 +85,14 @@ class _Tree:
         return list(s["children"]) if s else list(self.named.get(path, []))
 
     def node(self, path: str) -> dict:
-        base = {"label": _label(path), "path": path, "input_keys": [], "output_keys": [], "remapping": {}}
         if path not in self.paths:
             outcomes = sorted({e["outcome"] for e in self.edges(_parent(path)) if e["from"] == _label(path)})
-            return {**base, "type": "State", "container": False, "outcomes": outcomes}
-        return {**base, "type": "Concurrence" if path in self.concurrent else "StateMachine", "container": True,
-                "outcomes": self.outcomes(path), "initial": self.initial.get(path, []),
-                "transitions": self.edges(path), "children": [self.node(path + "/" + c) for c in self.children(path)]}
+            return schema.node(_label(path), path, "State", False, outcomes, [], [], {})
+        node = schema.node(_label(path), path, "Concurrence" if path in self.concurrent else "StateMachine", True,
+                           self.outcomes(path), [], [], {})
+        node.update(schema.container_fields(self.initial.get(path, []), self.edges(path),
+                                            [self.node(path + "/" + c) for c in self.children(path)]))
+        return node
 
     def outcome(self, path: str, last: list[str], returned: list[str]) -> tuple[str, str | None]:
         """(the container's outcome, its last state's) from the edges of its last states into its
@@ -121,12 +123,13 @@ class _Machine:
         self.run: str | None = None
         self.t = 0.0
 
-    def _event(self, kind: str, path: str, fields: dict) -> dict:
+    def _event(self, make: Callable[..., dict], path: str, *fields: Any) -> dict:
+        """The next event, made by the schema's maker of its kind (``schema.build``)."""
         self.seq += 1
-        return schema.event(self.seq, self.t, self.run, self.name, kind, path, fields)
+        return make(self.seq, self.t, self.run, self.name, path, *fields)
 
     def structure(self) -> dict:
-        return self._event("structure", self.tree.root, {"root": self.tree.node(self.tree.root)})
+        return self._event(build.structure, self.tree.root, self.tree.node(self.tree.root))
 
     def status(self, m: Message) -> Iterator[dict]:
         self.t = m.t
@@ -136,7 +139,7 @@ class _Machine:
             data = safe_pickle.local_data(f["local_data"]) if f["local_data"] else {}
         except ValueError as exc:
             data = {}
-            yield self._event("log", path, {"level": "warn", "msg": "userdata not read: %s" % exc})
+            yield self._event(build.log, path, "warn", "userdata not read: %s" % exc)
         if not isinstance(data, dict):
             data = {"local_data": data}
         data = encode_userdata(data)  # compared and sent encoded: each value encoded once
@@ -165,8 +168,7 @@ class _Machine:
         initial = self.tree.initial.get(path, []) or seen
         self.active[path] = list(initial)
         self.userdata[path] = data
-        yield self._event("start", path, {"initial": initial, "active": list(initial),
-                                          "userdata": data})
+        yield self._event(build.start, path, initial, list(initial), data)
         yield from self._move(path, seen)
 
     def _move(self, path: str, now: list[str]) -> Iterator[dict]:
@@ -181,8 +183,7 @@ class _Machine:
                 yield from self._leave(path, state, None)
                 remaining = [s for s in before if s not in left[:i + 1]]
                 self.active[path] = remaining
-                yield self._event("transition", path, {"from": state, "outcome": self.tree.step(path, state, None),
-                                                       "to": None, "active": remaining})
+                yield self._event(build.transition, path, state, self.tree.step(path, state, None), None, remaining)
             self.active[path] = list(now)
             return
         source = before[0] if before else None
@@ -193,8 +194,7 @@ class _Machine:
             self.left[path] = [source]
         self.active[path] = list(now)
         if source is not None:
-            yield self._event("transition", path, {"from": source, "outcome": outcome, "to": target,
-                                                   "active": list(now)})
+            yield self._event(build.transition, path, source, outcome, target, list(now))
 
     def _leave(self, path: str, state: str, outcome: str | None) -> Iterator[dict]:
         """A state its container left: when it is a running container, it terminated (with ``outcome``,
@@ -210,18 +210,16 @@ class _Machine:
         last = self.active.pop(path) or self.left.get(path, [])
         known = [self.ended[path + "/" + s] for s in last if path + "/" + s in self.ended]
         own, state_outcome = self.tree.outcome(path, last, known)
-        fields = {"last": last, "outcome": outcome or own, "active": []}
-        self.ended[path] = fields["outcome"]
-        if state_outcome is not None:
-            fields["state_outcome"] = state_outcome
-        yield self._event("terminate", path, fields)
+        self.ended[path] = outcome = outcome or own
+        yield self._event(build.terminate, path, last, outcome, [],
+                          schema.ABSENT if state_outcome is None else state_outcome)
 
     def _userdata(self, path: str, data: dict) -> Iterator[dict]:
         old = self.userdata.get(path, {})
         changed = {k: v for k, v in data.items() if k not in old or dumps(old[k]) != dumps(v)}  # 1 is not True
         self.userdata[path] = data
         if changed:
-            yield self._event("userdata", path, {"changes": changed})
+            yield self._event(build.userdata, path, changed)
 
 
 def events(messages: Iterable[Message]) -> Iterator[dict]:

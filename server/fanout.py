@@ -32,6 +32,7 @@ import threading
 import time
 from typing import Any, Callable
 
+from fsm.observation import schema
 from fsm.observation.encoding import dumps, encoded
 from fsm.observation.status import Status
 
@@ -41,15 +42,14 @@ from .timeline import TimelineIndex
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
 MAX_BATCH = 1000           # events per frame at most (a paced client: up to CLIENT_QUEUE)
-MAX_PACE = 10.0            # s: the slowest pace a client may ask for
-HISTORY = 5000             # events of the current run a new client is sent for its log, at most
+MAX_PACE = schema.MAX_PACE_MS / 1000  # s: the slowest pace a client may ask for
+HISTORY = schema.HISTORY_LIMIT  # events of the current run a new client is sent for its log, at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
 HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
 KEYFRAME_EVERY = 1000      # a copy of the Status every this many events, for the status at a seq the ring holds
 DRAIN_INTERVAL = 0.02      # s after a drain during which machine threads hand over without waking the loop
 
-_FRAME_HEAD = b'{"type":"events","events":['
-_FRAME_TAIL = b"]}"
+_FRAME_HEAD, _FRAME_TAIL = schema.list_frame("events")
 
 
 class Feed:
@@ -167,21 +167,20 @@ class Feed:
                 return cached[1], cached[2]
             data = status.to_dict()
             key = (id(status), status.last_seq)
-        frame = dumps({"type": "snapshot", "status": data, "last_seq": key[1]}).decode()
+        frame = dumps(schema.frame.snapshot(data, key[1])).decode()
         self._snapshot = (key[0], key[1], frame)
         return key[1], frame
 
-    def run_history(self, upto: int) -> str:
-        """The current run's events up to ``upto`` (from the ring, the newest ``HISTORY`` at most), as
-        JSON ``{"complete", "events"}``; ``complete`` says whether it reaches back to the run's start."""
+    def run_history(self, upto: int) -> bytes:
+        """The current run's events up to ``upto`` (from the ring, the newest ``HISTORY`` at most), as a
+        snapshot's encoded ``history``; its ``complete`` says whether it reaches back to the run's start."""
         with self.lock:
             start = self.status.run_seq
         ring = self.ring
         first = ring[0][0] if ring else upto + 1
         events = [data for seq, data in ring if start <= seq <= upto]
         complete = first <= start and len(events) <= HISTORY
-        return (b'{"complete":%s,"events":[%s]}'
-                % (b"true" if complete else b"false", b",".join(events[-HISTORY:]))).decode()
+        return schema.encoded_history(complete, events[-HISTORY:])
 
     def keeps_after(self, since: int) -> bool:
         """Whether the ring still holds every event after ``since`` (a client can resume from there)."""
@@ -266,9 +265,9 @@ class Client:
         frames = []
         missed = seq - self.cursor + 1 if self.cursor else 0
         if missed > 0:
-            frames.append('{"type":"missed","count":%d}' % missed)
+            frames.append(dumps(schema.frame.missed(missed)).decode())
         if not self.cursor:  # a new client: the snapshot also carries the current run's events so far
-            frame = frame[:-1] + ',"history":' + feed.run_history(seq) + "}"
+            frame = schema.with_history(frame, feed.run_history(seq))
         frames.append(frame)
         self.need_snapshot = False
         self.cursor = seq + 1

@@ -125,8 +125,8 @@ class Hub:
         entry = MachineEntry(rep.machine, "local")
         entry.reporter = rep
         entry.handle = MachineHandle(machine, rep, can_start, starter, holder)
-        entry.status.apply(schema.event(rep.last_seq, time.time(), rep.run, rep.machine, "structure", rep.root_path,
-                                        {"root": rep.structure()}))
+        entry.status.apply(schema.build.structure(rep.last_seq, time.time(), rep.run, rep.machine, rep.root_path,
+                                                  rep.structure()))
         entry.loop_seq = rep.last_seq
         entry.observer = Observer(entry, self.fanout)
         if recording is not None:

@@ -1,4 +1,8 @@
-"""Request and response models of the REST API (docs/api.md); OpenAPI is generated from these."""
+"""Request and response models of the REST API (docs/api.md); OpenAPI is generated from these.
+
+The shapes the schema defines (fsm/observation/schema/: a machine's status and what it holds, a
+breakpoint, a structure node) are restated here for OpenAPI's sake, with their descriptions, and
+tests/unit/test_models_schema.py fails when a model and its shape in the schema differ."""
 
 from __future__ import annotations
 
@@ -6,7 +10,7 @@ from typing import Any, Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from fsm.observation.schema import SOURCES
+from fsm.observation.schema import DEADMAN_ACTIONS, SOURCES
 
 JsonValue = Any
 
@@ -110,13 +114,16 @@ class StructureNode(BaseModel):
     initial: Optional[list[str]] = None
     children: Optional[list[StructureNode]] = None
     transitions: Optional[list[Transition]] = None
+    default_outcome: Optional[str] = Field(None, description="a Concurrence's")
+    outcome_map: Optional[dict[str, dict[str, str]]] = Field(None, description="a Concurrence's {container "
+                                                             "outcome: {child: outcome}}")
 
 
 class LastTransition(BaseModel):
     model_config = ConfigDict(populate_by_name=True)
 
     from_: str = Field(alias="from")
-    outcome: Optional[str] = None
+    outcome: str
     to: Optional[str] = None
     seq: int = Field(description="the event that made it")
 
@@ -152,13 +159,6 @@ class PendingPreempt(BaseModel):
     serviced: list[str] = Field(description="the states that serviced it so far")
 
 
-class Breakpoint(BaseModel):
-    state: str = Field(description="the state's path")
-    at: str = Field(description="'before' it runs or 'after' it returned")
-    outcome: Optional[str] = Field(default=None, description="after: only this outcome")
-    when: Optional[str] = Field(default=None, description="a condition over its container's userdata")
-
-
 class Hold(BaseModel):
     path: str = Field(description="the holding container")
     state: str
@@ -175,7 +175,7 @@ class DebugState(BaseModel):
     mode: str = Field(description="run, pause or step")
     level: Optional[str] = Field(default=None, description="step: the container whose next transition ends it")
     holds: list[Hold]
-    breakpoints: list[Breakpoint]
+    breakpoints: list[BreakpointSpec]
 
 
 class MachineStatus(BaseModel):
@@ -361,7 +361,7 @@ class LeaseHolder(BaseModel):
 
 class Deadman(BaseModel):
     after: float = Field(description="seconds without a heartbeat from the holder before the action")
-    action: Literal["pause", "preempt", "none"]
+    action: Literal[DEADMAN_ACTIONS]  # type: ignore[valid-type]
 
 
 class LeaseState(BaseModel):
@@ -388,3 +388,4 @@ class Delivered(BaseModel):
 
 
 StructureNode.model_rebuild()
+DebugState.model_rebuild()

@@ -150,16 +150,16 @@ class Publisher:
         return batch
 
     def _snapshots(self) -> list[dict]:
-        return [schema.event(status.last_seq, time.time(), status.run, name, "snapshot",
-                             status.root_path or "/SM_ROOT", {"status": status.to_dict()})
+        return [schema.build.snapshot(status.last_seq, time.time(), status.run, name, status.root_path or "/SM_ROOT",
+                                      status.to_dict())
                 for name, status in self._statuses.items() if status.last_seq]
 
     def _hello(self) -> str:
         """Which machines take controls, sent first on every connection and again after an attach."""
         self._announced = self._handles_changed
         handles = dict(self._handles)
-        return dumps({"type": "hello", "controllable": sorted(handles),
-                      "can_start": {name: handle.can_start for name, handle in handles.items()}}).decode()
+        return dumps(schema.frame.hello(sorted(handles),
+                                        {name: handle.can_start for name, handle in handles.items()})).decode()
 
     _announced = -1
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any, Awaitable, Callable
 from pydantic import ValidationError
 
 from fsm.control.handle import ControlError
+from fsm.observation import schema
 from fsm.observation.encoding import dumps
 
 from .models import BreakpointSpec
@@ -125,8 +126,7 @@ class IngestLink:
         try:
             if self.closed:
                 raise not_connected(machine)
-            frame = {"type": "control", "id": answer_id, "machine": machine, "action": action, "params": params,
-                     "client": client}
+            frame = schema.frame.control(answer_id, machine, action, params, client)
             try:
                 asyncio.run_coroutine_threadsafe(self.send(frame), self.loop).result(ANSWER_TIMEOUT)
             except TimeoutError:
@@ -198,8 +198,7 @@ class RemoteHandle:
     def lease_changed(self, held: bool, after: float, action: str) -> None:
         """Tell the publisher (server/lease.py calls this): while a lease is held, it applies ``action``
         itself when its connection to this server is gone for ``after`` seconds."""
-        self._lease = {"type": "lease", "machine": self.name, "held": bool(held), "after": float(after),
-                       "action": action}
+        self._lease = schema.frame.lease(self.name, bool(held), float(after), action)
         link = self.link
         if link is not None:
             link.post(self._lease)

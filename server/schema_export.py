@@ -1,8 +1,9 @@
-"""The event schema (fsm/observation/schema.py) as the browser and the docs read it.
+"""The schema (fsm/observation/schema/) as the browser and the docs read it.
 
-``static/schema.js`` and the field tables of ``docs/events.md`` are generated from the one
-definition in ``fsm.observation.schema``; ``tests/unit/test_schema_export.py`` regenerates both and fails on any
-difference. After changing the schema: ``python -m server.schema_export``.
+``static/schema.js`` (its constants, and JSDoc typedefs of every event, frame and shape) and the
+field tables of ``docs/events.md`` are generated from the one definition in ``fsm.observation.schema``;
+``tests/unit/test_schema_export.py`` regenerates both and fails on any difference. After changing the
+schema: ``python -m server.schema_export``.
 """
 
 from __future__ import annotations
@@ -19,11 +20,42 @@ DOC_PATH = os.path.join(ROOT, "docs", "events.md")
 _BLOCK = re.compile(r"(<!-- schema:(\w+) -->\n).*?(<!-- /schema -->)", re.S)
 
 
+def _pascal(name: str) -> str:
+    return "".join(part.capitalize() for part in name.replace("-", "_").split("_"))
+
+
+def _typedef(name: str, doc: str, fields: tuple[schema.Field, ...], constants: tuple[tuple[str, str], ...] = ()) -> str:
+    """A JSDoc typedef of an object: ``constants`` (field, its one value as JS) first, then ``fields``."""
+    lines = ["/**", " * " + doc, " * @typedef {Object} " + name]
+    lines += [" * @property {%s} %s" % (value, field) for field, value in constants]
+    lines += [(" * @property {%s} %s %s" % (f.type.js, f.name if f.required else "[%s]" % f.name, f.doc)).rstrip()
+              for f in fields]
+    return "\n".join(lines + [" */"]) + "\n"
+
+
+def typedefs() -> str:
+    """JSDoc typedefs of every event kind (``TransitionEvent``, ..., ``FsmEvent``), every frame
+    (``SnapshotFrame``, ..., ``Frame``) and every shape they hold (``MachineStatus``, ``Breakpoint``, ...)."""
+    out = []
+    for name, kind in schema.KINDS.items():
+        this_kind = schema.Type(name, lambda v: None, js='"%s"' % name)
+        envelope = tuple(schema.Field(f.name, this_kind) if f.name == "kind" else f for f in schema.ENVELOPE)
+        out.append(_typedef(_pascal(name) + "Event", kind.doc, envelope + kind.fields))
+    out.append("/** @typedef {%s} FsmEvent */\n" % "|".join(_pascal(n) + "Event" for n in schema.KINDS))
+    for name, message in schema.MESSAGES.items():
+        out.append(_typedef(_pascal(name) + "Frame", "%s (%s)." % (message.doc[:-1], message.sender), message.fields,
+                            (("type", '"%s"' % name),)))
+    out.append("/** @typedef {%s} Frame */\n" % "|".join(_pascal(n) + "Frame" for n in schema.MESSAGES))
+    for js, shape in sorted(schema.SHAPES.items()):
+        out.append(_typedef(js, shape.name[0].upper() + shape.name[1:] + ".", shape.shape))
+    return "\n".join(out)
+
+
 def javascript() -> str:
     """The text of static/schema.js."""
     escapes = {chr(code): text for code, text in schema.ID_ESCAPES.items()}
     pattern = "".join("\\u%04x" % ord(c) for c in escapes)
-    return """// Generated from fsm/observation/schema.py by `python -m server.schema_export`: do not edit by hand
+    return """// Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
 // (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
 
 /** The event schema version this page reads. */
@@ -63,7 +95,11 @@ export function containerKind(node) {
   if (CONTAINER_TYPES.includes(type)) return type;
   return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
 }
-""" % {"version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
+
+// The shapes: every event, every websocket frame, a machine's status and what it holds
+// (import one with /** @typedef {import("./schema.js").NAME} NAME */).
+
+%(typedefs)s""" % {"typedefs": typedefs(), "version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
        "sources": json.dumps({s: s for s in schema.SOURCES}),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],

@@ -7,6 +7,8 @@ import { api } from "./api.js";
 import { editBreakpoint } from "./dialogs.js";
 import { breakpointText } from "./transcript.js";
 
+/** @typedef {import("./schema.js").Breakpoint} Breakpoint */
+
 /** The states of `status` (a Status) with a breakpoint, and those where the machine holds. */
 export function debugMarks(status) {
   const debug = status.debug;
@@ -35,7 +37,9 @@ export class Breakpoints {
     const why = path === this.store.status.root_path ? "the root is in no container that could hold it"
       : this.controls.refusal() || (this.live() ? "" : "not live: go back to live to set breakpoints");
     const item = (label, action, title = why) => ({ label, action, disabled: Boolean(why), title });
-    const add = (what, at) => () => this._replace(what, (set) => [...set, { state: path, at, outcome: null, when: null }]);
+    /** @type {(at: string) => Breakpoint} */
+    const breakpoint = (at) => ({ state: path, at, outcome: null, when: null });
+    const add = (what, at) => () => this._replace(what, (set) => [...set, breakpoint(at)]);
     const items = [
       item("Break before", add("Break before", "before")),
       item("Break after", add("Break after", "after")),

@@ -1,4 +1,4 @@
-// Generated from fsm/observation/schema.py by `python -m server.schema_export`: do not edit by hand
+// Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
 // (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
 
 /** The event schema version this page reads. */
@@ -38,3 +38,420 @@ export function containerKind(node) {
   if (CONTAINER_TYPES.includes(type)) return type;
   return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
 }
+
+// The shapes: every event, every websocket frame, a machine's status and what it holds
+// (import one with /** @typedef {import("./schema.js").NAME} NAME */).
+
+/**
+ * The whole container tree.
+ * @typedef {Object} StructureEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"structure"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {StructureNode} root the root container's node; its path is the event's path
+ */
+
+/**
+ * A container began executing.
+ * @typedef {Object} StartEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"start"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {Array<string>} initial
+ * @property {Array<string>} active a Concurrence: all its children
+ * @property {Object<string, *>} userdata the container's whole userdata, encoded
+ */
+
+/**
+ * The container's active states changed.
+ * @typedef {Object} TransitionEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"transition"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {string} from the state that returned
+ * @property {string} outcome what it returned
+ * @property {(string|null)} to the next state; null when a Concurrence child finished
+ * @property {Array<string>} active the container's active states now
+ */
+
+/**
+ * A container finished.
+ * @typedef {Object} TerminateEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"terminate"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {Array<string>} last the last active state(s)
+ * @property {(string|null)} outcome null: ended without an outcome
+ * @property {Array<string>} [active]
+ * @property {(string|null)} [state_outcome] the outcome the last state returned
+ * @property {Object<string, (string|null)>} [outcomes] a Concurrence's children's outcomes
+ * @property {(string|null)} [error] 'ExceptionClass: message' when it failed
+ */
+
+/**
+ * Keys of a container's userdata written since the last such event.
+ * @typedef {Object} UserdataEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"userdata"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {Object<string, *>} changes {key: encoded value}
+ */
+
+/**
+ * A preempt was requested of, or serviced by, the state at path.
+ * @typedef {Object} PreemptEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"preempt"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {("requested"|"serviced")} phase
+ */
+
+/**
+ * A state raised, or a container failed.
+ * @typedef {Object} ErrorEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"error"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {(string|null)} state the child that raised
+ * @property {string} exc_type the root cause's class
+ * @property {string} message
+ * @property {string} [traceback] the whole chain
+ * @property {string} [wrapped_as] the SMACH exception that carried it
+ */
+
+/**
+ * A log line the other events do not already say.
+ * @typedef {Object} LogEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"log"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {("debug"|"info"|"warn"|"error")} level
+ * @property {string} msg
+ */
+
+/**
+ * Action feedback received by a SimpleActionState.
+ * @typedef {Object} FeedbackEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"feedback"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {string} action the action's name
+ * @property {*} feedback encoded
+ */
+
+/**
+ * Somebody asked the machine to do something.
+ * @typedef {Object} ControlEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"control"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {string} action preempt, initial-state, start, publish, ...
+ * @property {(string|null)} [reason] the operator's words
+ * @property {string} client who asked: an address, the role and the page ('127.0.0.1 (operator, page 3f2a9c1d)'), or 'deadman'
+ * @property {string} result 'accepted' or why not
+ * @property {Object<string, *>} [params] what was asked
+ */
+
+/**
+ * The debugger (fsm.debugging) changed mode, held or released a transition, forced an outcome or replaced its breakpoints; path is the container's (the root's for mode and breakpoints).
+ * @typedef {Object} DebugEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"debug"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {("mode"|"hold"|"release"|"forced"|"breakpoints")} action
+ * @property {("run"|"pause"|"step")} [mode] mode: what it is now
+ * @property {(string|null)} [level] mode step: the container whose next transition ends the step (null: the next anywhere)
+ * @property {string} [state] hold, release, forced: the child's label
+ * @property {("before"|"after")} [at] hold, release: before the child runs, or after it returned (the transition held)
+ * @property {(string|null)} [outcome] hold: the outcome to be taken; release, forced: the one taken
+ * @property {(string|null)} [returned] forced: what the state returned (null: it did not run)
+ * @property {("pause"|"step"|"breakpoint")} [reason] hold: why
+ * @property {string} [detail] hold: in words ('hit breakpoint before PICK/CLOSE when ...')
+ * @property {(string|null)} [by] mode, forced, breakpoints: who asked; release: what ended the hold (resume, step, force, preempt, shutdown, detach)
+ * @property {Array<Breakpoint>} [breakpoints] breakpoints: the whole set
+ */
+
+/**
+ * The robot's pose, sampled at the rate the 3D view draws it (the demo: 30 Hz).
+ * @typedef {Object} PoseEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"pose"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {Object<string, number>} joints joint positions by joint name (radians, metres)
+ * @property {Object<string, Array<number>>} [bodies] free bodies' poses by name: [x, y, z, qw, qx, qy, qz] in the world frame
+ */
+
+/**
+ * The full rebuilt state of one machine at seq.
+ * @typedef {Object} SnapshotEvent
+ * @property {number} v schema version
+ * @property {number} seq per machine, strictly increasing, never reset while the process lives
+ * @property {number} t wall-clock seconds (time.time())
+ * @property {(string|null)} [run] id of one top-level execution (null before the first)
+ * @property {string} machine the machine's name, unique within a process or server
+ * @property {"snapshot"} kind
+ * @property {string} path the container (for feedback: the state) the event is about
+ * @property {MachineStatus} status the machine's state after the event seq
+ */
+
+/** @typedef {StructureEvent|StartEvent|TransitionEvent|TerminateEvent|UserdataEvent|PreemptEvent|ErrorEvent|LogEvent|FeedbackEvent|ControlEvent|DebugEvent|PoseEvent|SnapshotEvent} FsmEvent */
+
+/**
+ * The machine's whole state: the first frame of a stream (unless it resumes), and again after missed (server to page).
+ * @typedef {Object} SnapshotFrame
+ * @property {"snapshot"} type
+ * @property {MachineStatus} status the machine's status with its structure (below)
+ * @property {number} last_seq the seq of the last event the status includes
+ * @property {History} [history] a new connection's only: the current run's events up to last_seq, for the log (already in the status: not to be applied again)
+ */
+
+/**
+ * Events in seq order: one per frame while the page keeps up, every event of the last 20 ms under a flood, or of the page's pace (server to page).
+ * @typedef {Object} EventsFrame
+ * @property {"events"} type
+ * @property {Array<FsmEvent>} events
+ */
+
+/**
+ * The page fell behind and this many events were dropped for it; a snapshot follows (server to page).
+ * @typedef {Object} MissedFrame
+ * @property {"missed"} type
+ * @property {number} count
+ */
+
+/**
+ * At most one frame every ms from now on, each with every event since the one before (0: each as it comes) (page to server).
+ * @typedef {Object} PaceFrame
+ * @property {"pace"} type
+ * @property {number} ms
+ */
+
+/**
+ * The fleet overview's tiles (GET /api/overview's), at most once a second (server to page).
+ * @typedef {Object} OverviewFrame
+ * @property {"overview"} type
+ * @property {number} now the server's clock
+ * @property {Array<Object<string, *>>} tiles as GET /api/overview
+ */
+
+/**
+ * Which of its machines take controls (and may be started again): first on each connection, again when a machine is attached (publisher to server).
+ * @typedef {Object} HelloFrame
+ * @property {"hello"} type
+ * @property {Array<string>} controllable machine names
+ * @property {Object<string, boolean>} can_start {name: bool}
+ */
+
+/**
+ * A REST control of one of its machines (docs/api.md) (server to publisher).
+ * @typedef {Object} ControlFrame
+ * @property {"control"} type
+ * @property {number} id its answer carries it
+ * @property {string} machine
+ * @property {string} action
+ * @property {Object<string, *>} params
+ * @property {string} client who asked
+ */
+
+/**
+ * The result of a control (publisher to server).
+ * @typedef {Object} AnswerFrame
+ * @property {"answer"} type
+ * @property {number} id the control's
+ * @property {number} status 200/202, or the 4xx the request answers
+ * @property {number} [seq] of the control event it caused
+ * @property {string} [detail] why not
+ * @property {Array<Breakpoint>} [breakpoints] breakpoints, get-breakpoints: the whole set
+ */
+
+/**
+ * The operator lease of one of its machines was taken, released or lapsed (server to publisher).
+ * @typedef {Object} LeaseFrame
+ * @property {"lease"} type
+ * @property {string} machine
+ * @property {boolean} held
+ * @property {number} after seconds
+ * @property {("pause"|"preempt"|"none")} action what the publisher does itself when its link is gone that long
+ */
+
+/**
+ * An event refused at the door (server to publisher).
+ * @typedef {Object} RejectedFrame
+ * @property {"rejected"} type
+ * @property {string} reason what is wrong, in words
+ * @property {*} machine the event's, if any
+ * @property {*} seq the event's, if any
+ */
+
+/** @typedef {SnapshotFrame|EventsFrame|MissedFrame|PaceFrame|OverviewFrame|HelloFrame|ControlFrame|AnswerFrame|LeaseFrame|RejectedFrame} Frame */
+
+/**
+ * A breakpoint.
+ * @typedef {Object} Breakpoint
+ * @property {string} state the state's path
+ * @property {("before"|"after")} at
+ * @property {(string|null)} outcome after: only this outcome
+ * @property {(string|null)} when a condition over the container's userdata
+ */
+
+/**
+ * A container status.
+ * @typedef {Object} ContainerStatus
+ * @property {Array<string>} active active children's labels
+ * @property {Array<string>} initial initial children's labels
+ * @property {Object<string, *>} userdata its userdata, encoded
+ * @property {boolean} running
+ * @property {(string|null)} outcome its last outcome
+ * @property {(LastTransition|null)} [last] its last transition in this run: {from, outcome, to, seq}
+ * @property {Object<string, Object<string, *>>} [changes] the keys its last transition wrote: {key: {old (absent: a new key), new}}
+ * @property {boolean} [written] its userdata was written since its last transition
+ */
+
+/**
+ * A debugger's state.
+ * @typedef {Object} DebugState
+ * @property {("run"|"pause"|"step")} mode
+ * @property {(string|null)} level
+ * @property {Array<Hold>} holds {path, state, at, outcome, reason, detail, seq}
+ * @property {Array<Breakpoint>} breakpoints {state, at, outcome, when}
+ */
+
+/**
+ * A history (below).
+ * @typedef {Object} History
+ * @property {boolean} complete whether it reaches back to the run's first event
+ * @property {Array<FsmEvent>} events oldest first, at most 5000
+ */
+
+/**
+ * A hold.
+ * @typedef {Object} Hold
+ * @property {string} path the holding container's
+ * @property {string} state
+ * @property {("before"|"after")} at
+ * @property {(string|null)} outcome
+ * @property {string} reason
+ * @property {string} detail
+ * @property {number} seq the hold event's
+ */
+
+/**
+ * A transition.
+ * @typedef {Object} LastTransition
+ * @property {string} from the state that returned
+ * @property {string} outcome
+ * @property {(string|null)} to the next state, or the container's outcome when it ended
+ * @property {number} seq the event's
+ */
+
+/**
+ * A machine status (fsm.observation.status.Status.to_dict()).
+ * @typedef {Object} MachineStatus
+ * @property {string} [machine] its name
+ * @property {(string|null)} [run] the current (or last) run
+ * @property {(string|null)} [root_path]
+ * @property {(StructureNode|null)} [structure]
+ * @property {Object<string, ContainerStatus>} containers
+ * @property {boolean} running the root is running
+ * @property {(string|null)} outcome the root's last outcome
+ * @property {(Object<string, *>|null)} [error] the last error event's fields
+ * @property {number} [last_seq]
+ * @property {(number|null)} [last_t]
+ * @property {number} [run_seq] the seq of the current run's first event
+ * @property {(PendingPreempt|null)} [preempt] a preempt requested and not over yet (below)
+ * @property {(Pose|null)} [pose] the robot's last recorded pose: {seq, t, joints, bodies}
+ * @property {(DebugState|null)} [debug] null until a debug event: {mode, level, holds, breakpoints} (below)
+ */
+
+/**
+ * A pending preempt.
+ * @typedef {Object} PendingPreempt
+ * @property {number} seq the preempt event's
+ * @property {number} t when it was requested
+ * @property {string} path of the container it was requested of
+ * @property {Array<string>} serviced paths of the states that serviced it so far
+ */
+
+/**
+ * A pose.
+ * @typedef {Object} Pose
+ * @property {number} seq the pose event's
+ * @property {number} t
+ * @property {Object<string, number>} joints
+ * @property {Object<string, Array<number>>} [bodies]
+ */
+
+/**
+ * A structure node (below).
+ * @typedef {Object} StructureNode
+ * @property {string} label the name its parent knows it by
+ * @property {string} path its parent's path, '/', its label
+ * @property {string} type the class name (StateMachine, Concurrence, CBState, ...)
+ * @property {boolean} container whether it holds children
+ * @property {Array<string>} outcomes registered outcomes, sorted
+ * @property {Array<string>} input_keys sorted
+ * @property {Array<string>} output_keys sorted
+ * @property {Object<string, string>} remapping its parent's remapping for it: {its key: the parent's key}
+ * @property {string} [doc] the first paragraph of its class's docstring (at most 500 characters); absent when the class has none or is one of fsm's own
+ * @property {Array<string>} [initial] a container's: initial states
+ * @property {Array<Transition>} [transitions] a container's: its edges (below)
+ * @property {Array<StructureNode>} [children] a container's: nodes, in add order
+ * @property {(string|null)} [default_outcome] a container's: a Concurrence's
+ * @property {Object<string, Object<string, string>>} [outcome_map] a container's: a Concurrence's {container outcome: {child: outcome}}
+ */
+
+/**
+ * A transition.
+ * @typedef {Object} Transition
+ * @property {string} from a child's label
+ * @property {string} outcome one of its outcomes
+ * @property {(string|null)} to a child's label, a container outcome, or null (the container outcome of the same name)
+ */

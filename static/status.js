@@ -1,8 +1,12 @@
 // The state of one machine rebuilt from its events: a line-for-line mirror of fsm/observation/status.py,
 // so that the browser, the recorder and replay cannot disagree.
 
+/** @typedef {import("./schema.js").MachineStatus} MachineStatus */
+/** @typedef {import("./schema.js").ContainerStatus} ContainerStatus */
+
 const REDUCED = new Set(["start", "transition", "userdata", "terminate", "error"]);
 
+/** @returns {ContainerStatus} */
 function containerEntry(initial) {
   return {
     active: [], initial: [...(initial || [])], userdata: {}, running: false, outcome: null,
@@ -207,6 +211,7 @@ export class Status {
     return out;
   }
 
+  /** @returns {MachineStatus} the schema's status (tests/browser/test_browser_dashboard.py: the same as Python's) */
   toDict() {
     return {
       machine: this.machine, run: this.run, root_path: this.root_path, structure: this.structure,

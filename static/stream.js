@@ -3,6 +3,11 @@
 
 import { streamProtocols } from "./token.js";
 
+/** @typedef {import("./schema.js").SnapshotFrame} SnapshotFrame */
+/** @typedef {import("./schema.js").EventsFrame} EventsFrame */
+/** @typedef {import("./schema.js").MissedFrame} MissedFrame */
+/** @typedef {import("./schema.js").PaceFrame} PaceFrame */
+
 const RATE_WINDOW_MS = 3000;
 const BACKOFF_MIN_MS = 250;
 const BACKOFF_MAX_MS = 4000;
@@ -11,6 +16,7 @@ export class Stream {
   /**
    * @param {string} name machine name
    * @param {object} handlers {snapshot(status, lastSeq, history), events(list), missed(count), state(state, detail)}
+   *   status: a MachineStatus, history: a History, list: FsmEvents (static/schema.js's typedefs)
    *   history (on a new connection only, else null): {complete, events}, the current run's events
    *   up to the snapshot, for the log (already in the snapshot's status: not to be applied again)
    * @param {object} options {url(name, since) -> ws url, checkResume(since) -> Promise<boolean>}
@@ -42,7 +48,9 @@ export class Stream {
   }
 
   _sendPace() {
-    if (this.ws?.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify({ type: "pace", ms: this.paceMs }));
+    /** @type {PaceFrame} */
+    const frame = { type: "pace", ms: this.paceMs };
+    if (this.ws?.readyState === WebSocket.OPEN) this.ws.send(JSON.stringify(frame));
   }
 
   start() {
@@ -120,7 +128,9 @@ export class Stream {
     this._open(since);
   }
 
+  /** One frame of the stream (static/schema.js: SnapshotFrame, EventsFrame, MissedFrame). */
   _onFrame(data) {
+    /** @type {SnapshotFrame|EventsFrame|MissedFrame} */
     let frame;
     try {
       frame = JSON.parse(data);

@@ -9,9 +9,11 @@ from __future__ import annotations
 
 from typing import Any, Callable
 
+from fsm.observation import schema
+
 from .handle import ControlError, MachineHandle
 
-DEADMAN_ACTIONS = ("pause", "preempt", "none")  # what a deadman does when its lease lapses
+DEADMAN_ACTIONS = schema.DEADMAN_ACTIONS  # what a deadman does when its lease lapses
 MAX_AFTER = 86400.0  # a deadman's delay longer than a day is not one (and would overflow a timer's wait)
 
 
@@ -99,7 +101,7 @@ def answer(handles: dict[str, MachineHandle], frame: dict) -> tuple[str, dict] |
         fields = {"status": err.status, "detail": err.message}
     except Exception as exc:  # the machine's own code failed: say so, keep publishing
         fields = {"status": 409, "detail": "the publishing process failed: %s: %s" % (type(exc).__name__, exc)}
-    return (machine if type(machine) is str else ""), {"type": "answer", "id": answer_id, **fields}
+    return (machine if type(machine) is str else ""), schema.frame.answer(answer_id, **fields)
 
 
 def lease_of(frame: dict) -> tuple[str, tuple[float, str] | None] | None:

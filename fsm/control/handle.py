@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any, Callable
 
 from fsm.observation import introspection
 from fsm.observation import structure
+from fsm.observation.schema import build
 
 if TYPE_CHECKING:
     from .debug import DebugControl
@@ -64,9 +65,8 @@ class MachineHandle:
 
     def emit_control(self, action: str, client: str, result: str, reason: str | None = None,
                      params: dict | None = None, path: str | None = None) -> int:
-        event = self.reporter.emit("control", path or self.reporter.root_path,
-                                   {"action": action, "reason": reason, "client": client, "result": result,
-                                    "params": params or {}})
+        event = self.reporter.send(build.control, path or self.reporter.root_path, action, client, result,
+                                   reason, params or {})
         return event["seq"] if event is not None else self.reporter.last_seq
 
     def lease_changed(self, held: bool, after: float, action: str) -> None:

@@ -11,8 +11,7 @@ import threading
 import traceback
 from typing import Any, Callable
 
-from . import log
-from ..observation import introspection
+from . import log, reporting
 from .container import Container
 from .exceptions import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
 from .state import State
@@ -141,8 +140,10 @@ class Concurrence(Container):
         return self._terminate(outcome, parent_ud)
 
     def _terminate(self, outcome: str, parent_ud: Any) -> str:
-        self._report("terminate", {"last": list(self._states), "outcome": outcome, "active": [],
-                                   "outcomes": {k: None if v is None else str(v) for k, v in self._child_outcomes.items()}})
+        rep = self._reporter
+        if rep is not None:
+            rep.terminate(self._path, list(self._states), outcome, [],
+                          outcomes={k: None if v is None else str(v) for k, v in self._child_outcomes.items()})
         self.call_termination_cbs(list(self._states), outcome)
         self._copy_output_keys(self.userdata, parent_ud)
         return outcome
@@ -156,12 +157,12 @@ class Concurrence(Container):
         self._failed_label, first = next(iter(failed.items()))
         if isinstance(first, (InvalidStateError, InvalidUserCodeError)) and getattr(first, "_fsm_own", False):
             raise first
-        raise introspection.carry_reported(
+        raise reporting.carry_reported(
             InvalidStateError("A concurrent state raised an exception during execution."), first) from first
 
     def _run_child(self, label: str, state: State) -> None:
         rep = self._reporter
-        prev = introspection.enter(rep, self._path) if rep is not None else introspection.NOT_ENTERED
+        prev = reporting.enter(rep, self._path) if rep is not None else reporting.NOT_ENTERED
         try:
             if self._transition_cbs:
                 self.call_transition_cbs()
@@ -187,8 +188,7 @@ class Concurrence(Container):
                 self._child_outcomes[label] = outcome
                 if rep is not None:
                     self._report_changes()
-                    rep.emit("transition", self._path, {"from": str(label), "outcome": str(outcome), "to": None,
-                                                        "active": self.get_active_states()})
+                    rep.transition(self._path, str(label), str(outcome), None, self.get_active_states())
                 if self._transition_cbs:
                     self.call_transition_cbs()
                 if self._child_termination_cb:
@@ -206,7 +206,7 @@ class Concurrence(Container):
                 self._pending -= 1
                 if not self._pending:
                     self._done_cond.notify_all()
-            introspection.leave(prev)
+            reporting.leave(prev)
 
     def _fail(self, label: str, error: BaseException) -> None:
         with self._done_cond:
@@ -222,7 +222,7 @@ class Concurrence(Container):
         """Thread-safe: flags this Concurrence and preempts every unfinished child."""
         with self._done_cond:
             self._preempt_requested = True
-            self._report("preempt", {"phase": "requested"})
+            self._report_preempt_requested()
             if self._is_running:
                 self._preempt_unfinished()
 

@@ -5,8 +5,7 @@ import traceback
 from contextlib import contextmanager
 from typing import Any, Callable, Iterator as TypingIterator
 
-from . import log
-from ..observation import introspection
+from . import log, reporting
 from .exceptions import InvalidConstructionError, InvalidStateError, InvalidTransitionError
 from .state import State
 from .user_data import UserData
@@ -39,7 +38,7 @@ class Container(State):
             self._report_error(self._on_failure(), exc)
             raise
         finally:
-            introspection.leave(ctx)
+            reporting.leave(ctx)
 
     def _execute(self, parent_ud: Any) -> Any:
         raise NotImplementedError()
@@ -127,55 +126,56 @@ class Container(State):
         except Exception:
             log.logerr("Could not execute termination callback: " + traceback.format_exc())
 
-    # Reporting: each a no-op unless a tool observes this machine.
+    # Reporting (fsm/core/reporting.py): each a no-op unless a tool observes this machine.
     def _report_start(self, parent_ud: Any) -> Any:
         """Run the global hooks for a top-level start; returns the thread context to restore."""
-        if parent_ud is None and introspection._hooks:
-            introspection.on_top_level_start(self)
+        if parent_ud is None and reporting.top_level_hooks:
+            reporting.on_top_level_start(self)
         rep = self._reporter
         if rep is None:
-            return introspection.NOT_ENTERED
+            return reporting.NOT_ENTERED
         if rep.root is self:
             rep.begin_run()
-        return introspection.enter(rep, self._path)
-
-    def _report(self, kind: str, fields: dict) -> None:
-        rep = self._reporter
-        if rep is not None:
-            rep.emit(kind, self._path, fields)
+        return reporting.enter(rep, self._path)
 
     def _report_changes(self) -> None:
         rep = self._reporter
         if rep is not None:
-            changes = introspection.take_changes(self.userdata)
-            if changes:
-                rep.emit("userdata", self._path, {"changes": changes})
+            written = self.userdata.take_written()
+            if written:
+                rep.userdata(self._path, written)
 
     def _report_started(self) -> None:
         rep = self._reporter
         if rep is not None:
-            self.userdata._dirty = set()
-            rep.emit("start", self._path, {"initial": [str(s) for s in self.get_initial_states()],
-                                           "active": [str(s) for s in self.get_active_states()],
-                                           "userdata": introspection.userdata_fields(self)})
+            self.userdata.track_writes()
+            rep.start(self._path, [str(s) for s in self.get_initial_states()],
+                      [str(s) for s in self.get_active_states()], self.userdata)
 
     def _report_error(self, label: Any, exc: BaseException) -> None:
         """An ``error`` event from the innermost container that saw ``exc``, then ``terminate``."""
         rep = self._reporter
         if rep is None:
             return
-        if not getattr(exc, "_fsm_reported", False):
-            rep.emit("error", self._path, introspection.error_fields(label, exc))
-            try:
-                exc._fsm_reported = True
-            except AttributeError:
-                pass
-        rep.emit("terminate", self._path, {"last": [] if label is None else [str(label)], "outcome": None,
-                                           "active": [], "error": "%s: %s" % (type(exc).__name__, exc)})
+        if reporting.mark_reported(exc):
+            rep.error(self._path, label, exc)
+        rep.terminate(self._path, [] if label is None else [str(label)], None, [],
+                      error="%s: %s" % (type(exc).__name__, exc))
+
+    def _report_ended(self, error: str) -> None:
+        """A run that ended without an outcome (and without an exception): ``error`` says why."""
+        rep = self._reporter
+        if rep is not None:
+            rep.terminate(self._path, [], None, [], error=error)
+
+    def _report_preempt_requested(self) -> None:
+        rep = self._reporter
+        if rep is not None:
+            rep.preempt(self._path, "requested")
 
     def request_preempt(self) -> None:
         State.request_preempt(self)
-        self._report("preempt", {"phase": "requested"})
+        self._report_preempt_requested()
 
     # Construction.
     def open(self) -> None:
@@ -206,7 +206,7 @@ class Container(State):
     @classmethod
     def _currently_opened_container(cls) -> "Container":
         """The container every construction call acts on (so also where the structure changes)."""
-        introspection.structure_changed()
+        reporting.structure_changed()
         if Container._any_containers_opened():
             opened = Container._construction_stack[-1]
             if not isinstance(opened, cls):

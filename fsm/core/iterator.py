@@ -3,8 +3,7 @@
 import traceback
 from typing import Any, Callable, Iterable
 
-from . import log
-from ..observation import introspection
+from . import log, reporting
 from .container import Container
 from .exceptions import InvalidUserCodeError
 from .state import State
@@ -97,16 +96,16 @@ class Iterator(Container):
                 outcome = state_outcome
                 break
             if rep is not None:
-                rep.emit("transition", self._path, {"from": str(self._state_label), "outcome": str(state_outcome),
-                                                    "to": str(self._state_label), "active": [str(self._state_label)]})
+                rep.transition(self._path, str(self._state_label), str(state_outcome), str(self._state_label),
+                               [str(self._state_label)])
             self.call_transition_cbs()
         # As in SMACH, every ending is mapped: a break by the state's outcome, exhaustion by the exhausted outcome.
         outcome = self._final_outcome_map.get(outcome, outcome)
         self._copy_output_keys(self.userdata, parent_ud)
         self._is_running = False
-        self._report("terminate", {"last": [str(self._state_label)],
-                                   "state_outcome": None if state_outcome is None else str(state_outcome),
-                                   "outcome": None if outcome is None else str(outcome), "active": []})
+        if rep is not None:
+            rep.terminate(self._path, [str(self._state_label)], None if outcome is None else str(outcome), [],
+                          state_outcome=None if state_outcome is None else str(state_outcome))
         self.call_termination_cbs(self._state_label, outcome)
         return outcome
 
@@ -116,13 +115,13 @@ class Iterator(Container):
         except InvalidUserCodeError:
             raise
         except Exception as exc:
-            raise introspection.carry_reported(InvalidUserCodeError(
+            raise reporting.carry_reported(InvalidUserCodeError(
                 "Could not execute iterator state '%s' of type '%s': " % (self._state_label, self._state)
                 + traceback.format_exc()), exc) from exc
 
     def request_preempt(self) -> None:
         State.request_preempt(self)
-        self._report("preempt", {"phase": "requested"})
+        self._report_preempt_requested()
         if self._is_running and self._state is not None:
             self._state.request_preempt()
 

@@ -8,9 +8,9 @@ from .util import has_smach_interface
 class State:
     """Base class of every state and container.
 
-    ``_reporter`` and ``_path`` are set by ``fsm.observation.introspection`` when a tool observes the
-    machine this state belongs to, and a container's ``_debugger`` by ``fsm.debugging`` when one
-    debugs it; they stay None otherwise, which costs nothing.
+    ``_reporter`` (a ``fsm.core.reporting.Reporter``) and ``_path`` are set by ``fsm.observation`` when
+    a tool observes the machine this state belongs to, and a container's ``_debugger`` by
+    ``fsm.debugging`` when one debugs it; they stay None otherwise, which costs nothing.
     """
 
     _reporter = None
@@ -56,7 +56,7 @@ class State:
         self._preempt_requested = False
         rep = self._reporter
         if rep is not None:
-            rep.emit("preempt", self._path, {"phase": "serviced"})
+            rep.preempt(self._path, "serviced")
 
     def recall_preempt(self) -> None:
         self._preempt_requested = False

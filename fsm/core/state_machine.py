@@ -8,8 +8,7 @@ import threading
 import traceback
 from typing import Any
 
-from . import log
-from ..observation import introspection
+from . import log, reporting
 from .container import Container
 from .exceptions import InvalidStateError, InvalidTransitionError, InvalidUserCodeError
 from .state import State
@@ -140,7 +139,7 @@ class StateMachine(Container):
                     log.logerr("State '%s' failed to execute." % last_state_label)
                     raise ex
                 except Exception as exc:
-                    raise introspection.carry_reported(InvalidUserCodeError(
+                    raise reporting.carry_reported(InvalidUserCodeError(
                         "Could not execute state '%s' of type '%s': " % (last_state_label, state)
                         + traceback.format_exc()), exc) from exc
             dbg = self._debugger
@@ -165,8 +164,7 @@ class StateMachine(Container):
             self._set_current_state(target)
             log.info_quiet("State machine transitioning '%s':'%s'-->'%s'" % (last_state_label, outcome, target))
             if rep is not None:
-                rep.emit("transition", self._path, {"from": str(last_state_label), "outcome": str(outcome),
-                                                    "to": str(target), "active": [str(target)]})
+                rep.transition(self._path, str(last_state_label), str(outcome), str(target), [str(target)])
             if self._transition_cbs:
                 self.call_transition_cbs()
             return None
@@ -181,8 +179,7 @@ class StateMachine(Container):
             self._set_current_state(None)
             log.info_quiet("State machine terminating '%s':'%s':'%s'" % (last_state_label, outcome, target))
             if rep is not None:
-                rep.emit("terminate", self._path, {"last": [str(last_state_label)], "state_outcome": str(outcome),
-                                                   "outcome": str(target), "active": []})
+                rep.terminate(self._path, [str(last_state_label)], str(target), [], state_outcome=str(outcome))
             self.call_termination_cbs([last_state_label], target)
             return target
         raise InvalidTransitionError("Outcome '%s' of state '%s' with transition target '%s' is neither a registered state nor a registered container outcome."
@@ -199,8 +196,7 @@ class StateMachine(Container):
                 self.check_consistency()
             except (InvalidStateError, InvalidTransitionError):
                 log.logerr("Container consistency check failed.")
-                self._report("terminate", {"last": [], "outcome": None, "active": [],
-                                           "error": "consistency check failed"})
+                self._report_ended("consistency check failed")
                 return None
             self._is_running = True
             self._preempted_label = None
@@ -224,7 +220,7 @@ class StateMachine(Container):
                 self._is_running = False
                 self._set_current_state(None)
             if container_outcome is None:
-                self._report("terminate", {"last": [], "outcome": None, "active": [], "error": "shutdown"})
+                self._report_ended("shutdown")
             self._copy_output_keys(self.userdata, parent_ud)
             return container_outcome
 
@@ -243,7 +239,7 @@ class StateMachine(Container):
         """Thread-safe: flags this machine and forwards the request to the running child."""
         with self._state_transitioning_lock:
             self._preempt_requested = True
-            self._report("preempt", {"phase": "requested"})
+            self._report_preempt_requested()
             if self._current_state is not None:
                 self._preempt_current_state()
 
@@ -257,7 +253,7 @@ class StateMachine(Container):
             log.logwarn("Attempting to set initial state to include more than one state, but the StateMachine container can only have one initial state. Taking the first one.")
         if len(initial_states) > 0:
             self._initial_state_label = initial_states[0]
-            introspection.structure_changed()
+            reporting.structure_changed()
         if userdata is not None:
             self.userdata.update(userdata)
 

@@ -6,9 +6,10 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..observation.schema import BREAKPOINT_FIELDS, POSITIONS
 from .condition import Condition, ConditionError
 
-POSITIONS = ("before", "after")
+FIELDS = tuple(f.name for f in BREAKPOINT_FIELDS)  # its JSON form's (fsm/observation/schema/status.py)
 
 
 class BreakpointError(ValueError):
@@ -35,9 +36,9 @@ class Breakpoint:
         """A breakpoint from its JSON form; raises BreakpointError saying what is wrong."""
         if not isinstance(spec, dict):
             raise BreakpointError("a breakpoint must be an object", "breakpoint")
-        unknown = sorted(set(spec) - {"state", "at", "outcome", "when"})
+        unknown = sorted(set(spec) - set(FIELDS))
         if unknown:
-            raise BreakpointError("unknown fields %s (a breakpoint has state, at, outcome, when)" % unknown, unknown[0])
+            raise BreakpointError("unknown fields %s (a breakpoint has %s)" % (unknown, ", ".join(FIELDS)), unknown[0])
         state, at = spec.get("state"), spec.get("at", "before")
         outcome, when = spec.get("outcome"), spec.get("when")
         if not isinstance(state, str) or not state.startswith("/"):
@@ -55,7 +56,8 @@ class Breakpoint:
         return cls(state, at, outcome, when or None, condition)
 
     def to_dict(self) -> dict:
-        return {"state": self.state, "at": self.at, "outcome": self.outcome, "when": self.when}
+        """Its JSON form, the schema's breakpoint."""
+        return {name: getattr(self, name) for name in FIELDS}
 
     def describe(self, root_path: str) -> str:
         """In words, the state named from below the root: ``before PICK/CLOSE when attempts > 2``."""

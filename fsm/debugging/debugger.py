@@ -21,6 +21,7 @@ One piece (about 300 lines) because the gates and the controls share one lock an
 
 from __future__ import annotations
 
+import functools
 import threading
 import weakref
 from dataclasses import dataclass
@@ -28,6 +29,7 @@ from typing import Any, Iterable
 
 from ..core import log
 from ..observation import introspection, structure
+from ..observation.schema import build
 from .breakpoint import Breakpoint, BreakpointError
 from .condition import ConditionError
 
@@ -156,7 +158,7 @@ class Debugger:
             self._breakpoints = {path: tuple(bps) for path, bps in chosen.items()}
             self._arm()
             listed = self.breakpoints()
-            self._emit(self.root_path, {"action": "breakpoints", "breakpoints": listed, "by": by})
+            self._emit(self.root_path, action="breakpoints", breakpoints=listed, by=by)
         return listed
 
     def detach(self) -> None:
@@ -176,8 +178,8 @@ class Debugger:
         forced = self._forced.pop(path, None) if self._forced else None
         if forced is not None:
             state.recall_preempt()
-            self._emit(container._path, {"action": "forced", "state": label, "outcome": forced[0], "returned": None,
-                                         "by": forced[1]})
+            self._emit(container._path, action="forced", state=label, outcome=forced[0], returned=None,
+                       by=forced[1])
             return forced[0]
         if container.preempt_requested():
             return None
@@ -192,8 +194,8 @@ class Debugger:
         forced = self._forced.pop(path, None) if self._forced else None
         if forced is not None:
             state.recall_preempt()
-            self._emit(container._path, {"action": "forced", "state": label, "outcome": forced[0],
-                                         "returned": None if outcome is None else str(outcome), "by": forced[1]})
+            self._emit(container._path, action="forced", state=label, outcome=forced[0],
+                       returned=None if outcome is None else str(outcome), by=forced[1])
             outcome = forced[0]
         if container.preempt_requested():
             return outcome
@@ -235,7 +237,7 @@ class Debugger:
             self.mode, self.level = "pause", None  # said by the hold event: a held machine is paused
             self._arm()
             self._holds.append(hold)
-        self._emit(container._path, {"action": "hold", **{k: v for k, v in hold.to_dict().items() if k != "path"}})
+        self._emit(container._path, action="hold", **{k: v for k, v in hold.to_dict().items() if k != "path"})
         with self._cond:
             while hold.released_by is None:
                 if container.preempt_requested() or log.is_shutdown():
@@ -244,10 +246,10 @@ class Debugger:
                 self._cond.wait(POLL)
         forced = hold.forced
         if forced is not None:
-            self._emit(container._path, {"action": "forced", "state": label, "outcome": forced[0],
-                                         "returned": hold.outcome, "by": forced[1]})
-        self._emit(container._path, {"action": "release", "state": label, "at": at,
-                                     "outcome": forced[0] if forced else hold.outcome, "by": hold.released_by})
+            self._emit(container._path, action="forced", state=label, outcome=forced[0],
+                       returned=hold.outcome, by=forced[1])
+        self._emit(container._path, action="release", state=label, at=at,
+                   outcome=forced[0] if forced else hold.outcome, by=hold.released_by)
         return hold
 
     def _release(self, holds: list[Hold], by: str) -> None:
@@ -263,7 +265,7 @@ class Debugger:
             return
         self.mode, self.level = mode, level
         self._arm()
-        self._emit(self.root_path, {"action": "mode", "mode": mode, "level": level, "by": by})
+        self._emit(self.root_path, action="mode", mode=mode, level=level, by=by)
 
     def _arm(self) -> None:
         armed = self.mode != "run" or bool(self._breakpoints) or bool(self._forced)
@@ -271,10 +273,10 @@ class Debugger:
             self.armed = armed
             self._bind(self if armed else None)
 
-    def _emit(self, path: str, fields: dict) -> None:
+    def _emit(self, path: str, **fields: Any) -> None:
         rep = introspection.reporter_of(self.machine)
         if rep is not None:
-            rep.emit("debug", path, fields)
+            rep.send(functools.partial(build.debug, **fields), path)
 
     def _state_at(self, path: str) -> Any:
         if path == self.root_path:

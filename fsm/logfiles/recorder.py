@@ -120,8 +120,8 @@ class Recorder:
         self._snapshot_at[status.machine] = status.last_seq + self.snapshot_every
         if status.root_path is None:  # no structure seen yet: nothing a reader could start from
             return
-        event = schema.event(status.last_seq, time.time(), status.run, status.machine, "snapshot",
-                             status.root_path, {"status": status.to_dict()})
+        event = schema.build.snapshot(status.last_seq, time.time(), status.run, status.machine, status.root_path,
+                                      status.to_dict())
         offset = self._taken + len(self._buf)
         self._index_chunks.append(_dumps_line({"machine": status.machine, "seq": status.last_seq, "t": status.last_t,
                                                "offset": offset}))

@@ -1,7 +1,10 @@
 """Turns a running machine into a stream of events (docs/events.md) for any number of observers.
 
-A machine nobody observes pays one ``is None`` test per step: containers check their
-``_reporter`` attribute, which stays None until ``attach`` binds the tree.
+``Reporter`` implements core's reporting seam (``fsm.core.reporting.Reporter``): core calls one
+method per kind with plain values, and the reporter encodes them, makes the event with the schema's
+maker of that kind (``schema.build``) and stamps it. A machine nobody observes pays one ``is None``
+test per step: containers check their ``_reporter`` attribute, which stays None until ``attach``
+binds the tree.
 """
 
 from __future__ import annotations
@@ -16,20 +19,17 @@ from threading import get_ident
 from time import time as _now
 from typing import Any, Callable
 
-from ..core import log
+from ..core import log, reporting
+from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
+from . import schema
 from .encoding import encode_userdata
-from .schema import MAX_DOC, event as _event
+from .schema import ABSENT, MAX_DOC, build
 from .structure import children, is_container
 
 DEFAULT_ROOT_PATH = "/SM_ROOT"
 
 Observer = Callable[[dict], None]
-Hook = Callable[[Any], None]
 
-_hooks: list[Hook] = []
-# Bumped by every construction call anywhere: a structure described before it may be stale.
-_generation = 0
-_tls = threading.local()
 _listening: set[Reporter] = set()
 _listening_lock = threading.Lock()
 
@@ -55,7 +55,7 @@ class Reporter:
     def add_observer(self, observer: Observer) -> None:
         """An observer with an ``attached(reporter)`` method is then given this reporter: one that acts
         on the machine too (a publisher that takes controls from afar) reaches it as ``reporter.root``."""
-        # Replaced, never mutated: emit iterates the list it read without the lock.
+        # Replaced, never mutated: send iterates the list it read without the lock.
         self._observers = self._observers + [observer]
         self._described_at = -1  # the newcomer has not seen the structure
         _set_listening(self, True)
@@ -69,8 +69,9 @@ class Reporter:
         if not self._observers:
             _set_listening(self, False)
 
-    def emit(self, kind: str, path: str | None, fields: dict | None = None) -> dict | None:
-        """Stamp and deliver one event; returns it (None when nobody listens)."""
+    def send(self, make: Callable[..., dict], path: str | None, *args: Any) -> dict | None:
+        """Stamp ``make(seq, t, run, machine, path, *args)`` (a maker of ``schema.build``) and deliver it;
+        returns it (None when nobody listens)."""
         observers = self._observers
         if not observers:
             return None
@@ -82,7 +83,7 @@ class Reporter:
         try:
             self._owner = me
             self._seq = seq = self._seq + 1
-            event = _event(seq, _now(), self.run, self.machine, kind, path, fields)
+            event = make(seq, _now(), self.run, self.machine, path, *args)
             for observer in observers:
                 try:
                     observer(event)
@@ -93,13 +94,40 @@ class Reporter:
             lock.release()
         return event
 
+    # Core's calls (fsm.core.reporting.Reporter), one per kind.
+    def start(self, path: str, initial: list[str], active: list[str], userdata: Any) -> None:
+        self.send(_start, path, initial, active, encode_userdata(userdata._data))
+
+    def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str]) -> None:
+        self.send(_transition, path, from_, outcome, to, active)
+
+    def terminate(self, path: str, last: list[str], outcome: str | None, active: list[str] = ABSENT,
+                  state_outcome: str | None = ABSENT, outcomes: dict = ABSENT, error: str | None = ABSENT) -> None:
+        self.send(_terminate, path, last, outcome, active, state_outcome, outcomes, error)
+
+    def userdata(self, path: str, written: dict) -> None:
+        self.send(_userdata, path, encode_userdata(written))
+
+    def preempt(self, path: str, phase: str) -> None:
+        self.send(_preempt, path, phase)
+
+    def error(self, path: str, state: Any, exc: BaseException) -> None:
+        """Describe the root cause (the user's own exception), not SMACH's wrapper around it."""
+        root = exc
+        while root.__cause__ is not None:
+            root = root.__cause__
+        self.send(_error, path, None if state is None else str(state), type(root).__name__, str(root),
+                   "".join(traceback.format_exception(type(exc), exc, exc.__traceback__)),
+                   type(exc).__name__ if root is not exc else ABSENT)
+
     def begin_run(self) -> None:
         """Called by the root container as it starts: a new run id, then the structure if it
         changed since it was last sent (or an observer joined since)."""
         self.run = uuid.uuid4().hex[:12]
-        if self._described_at != _generation:
-            self._described_at = _generation
-            self.emit("structure", self.root_path, {"root": self.structure()})
+        generation = reporting.structure_generation()
+        if self._described_at != generation:
+            self._described_at = generation
+            self.send(build.structure, self.root_path, self.structure())
 
     def structure(self) -> dict:
         """Bind every state of the tree to this reporter and describe the tree (docs/events.md)."""
@@ -124,33 +152,25 @@ def class_doc(cls: type) -> str | None:
 def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict) -> dict:
     state._reporter = rep
     state._path = path
-    node = {"label": label, "path": path, "type": type(state).__name__,
-            "container": is_container(state),
-            "outcomes": sorted(map(str, state.get_registered_outcomes())),
-            "input_keys": sorted(map(str, state.get_registered_input_keys())),
-            "output_keys": sorted(map(str, state.get_registered_output_keys())),
-            "remapping": {str(k): str(v) for k, v in (remapping or {}).items()}}
     doc = class_doc(type(state))
-    if doc is not None:
-        node["doc"] = doc
-    if not node["container"]:
+    container = is_container(state)
+    node = schema.node(label, path, type(state).__name__, container, sorted(map(str, state.get_registered_outcomes())),
+                       sorted(map(str, state.get_registered_input_keys())),
+                       sorted(map(str, state.get_registered_output_keys())),
+                       {str(k): str(v) for k, v in (remapping or {}).items()}, ABSENT if doc is None else doc)
+    if not container:
         return node
     if state.userdata._dirty is None:
-        state.userdata._dirty = set()
+        state.userdata.track_writes()
     remappings = getattr(state, "_remappings", {})
-    node["initial"] = [str(s) for s in state.get_initial_states()]
-    node["children"] = [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
-                        for lbl, child in children(state).items()]
-    node["transitions"] = [{"from": str(frm), "outcome": str(outcome), "to": None if to is None else str(to)}
-                           for outcome, frm, to in state.get_internal_edges()]
+    node.update(schema.container_fields(
+        [str(s) for s in state.get_initial_states()],
+        [schema.edge(str(frm), str(outcome), None if to is None else str(to))
+         for outcome, frm, to in state.get_internal_edges()],
+        [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
+         for lbl, child in children(state).items()]))
     node.update(state._introspection_info())
     return node
-
-
-def structure_changed() -> None:
-    """A container was built or changed: the next run of every observed machine re-describes it."""
-    global _generation
-    _generation += 1
 
 
 def attach(machine: Any, observer: Observer | None = None, name: str | None = None,
@@ -175,43 +195,10 @@ def reporter_of(machine: Any) -> Reporter | None:
     return rep if rep is not None and rep.root is machine else None
 
 
-def add_global_hook(hook: Hook) -> None:
-    """``hook(container)`` runs whenever a top-level container starts executing, before its first event."""
-    _hooks.append(hook)
-
-
-def remove_global_hook(hook: Hook) -> None:
-    if hook in _hooks:
-        _hooks.remove(hook)
-
-
-def on_top_level_start(container: Any) -> None:
-    for hook in list(_hooks):
-        try:
-            hook(container)
-        except Exception:
-            sys.stderr.write("fsm: a global introspection hook failed:\n" + traceback.format_exc())
-
-
-NOT_ENTERED = object()
-
-
-def enter(rep: Reporter, path: str) -> Any:
-    """Mark ``path`` as the innermost observed container running on this thread (for log events)."""
-    prev = getattr(_tls, "ctx", None)
-    _tls.ctx = (rep, path)
-    return prev
-
-
-def leave(prev: Any) -> None:
-    if prev is not NOT_ENTERED:
-        _tls.ctx = prev
-
-
 def _on_log(level: str, msg: str) -> None:
-    ctx = getattr(_tls, "ctx", None)
+    ctx = reporting.current()
     if ctx is not None:
-        ctx[0].emit("log", ctx[1], {"level": level, "msg": msg})
+        ctx[0].send(_log, ctx[1], level, msg)
 
 
 def _set_listening(rep: Reporter, on: bool) -> None:
@@ -220,34 +207,6 @@ def _set_listening(rep: Reporter, on: bool) -> None:
         log.listener = _on_log if _listening else None
 
 
-def userdata_fields(container: Any) -> dict:
-    return encode_userdata(container.userdata._data)
-
-
-def take_changes(userdata: Any) -> dict | None:
-    """Encode the keys written since the last call, or None when nothing was written."""
-    dirty = userdata._dirty
-    if not dirty:
-        return None
-    userdata._dirty = set()
-    data = userdata._data
-    return encode_userdata({k: data[k] for k in dirty if k in data})
-
-
-def carry_reported(error: BaseException, cause: BaseException) -> BaseException:
-    """``error`` wraps ``cause``: when an ``error`` event already described ``cause``, none is sent for ``error``."""
-    if getattr(cause, "_fsm_reported", False):
-        error._fsm_reported = True  # type: ignore[attr-defined]
-    return error
-
-
-def error_fields(state_label: Any, exc: BaseException) -> dict:
-    """Describe the root cause (the user's own exception), not SMACH's wrapper around it."""
-    root = exc
-    while root.__cause__ is not None:
-        root = root.__cause__
-    fields = {"state": None if state_label is None else str(state_label), "exc_type": type(root).__name__,
-              "message": str(root), "traceback": "".join(traceback.format_exception(type(exc), exc, exc.__traceback__))}
-    if root is not exc:
-        fields["wrapped_as"] = type(exc).__name__
-    return fields
+# The makers of the kinds core reports, bound once.
+_start, _transition, _terminate, _userdata = build.start, build.transition, build.terminate, build.userdata
+_preempt, _error, _log = build.preempt, build.error, build.log

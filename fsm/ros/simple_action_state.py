@@ -8,6 +8,7 @@ from ..core import log
 from .actionlib import GoalStatus, SimpleActionClient
 from .bus import Bus, get_bus
 from ..observation.encoding import encode
+from ..observation.schema import build
 from ..core.exceptions import InvalidStateError
 from .preemptible import PreemptibleState, to_seconds
 from .slots import set_slot, store
@@ -169,5 +170,5 @@ class SimpleActionState(PreemptibleState):
     def _on_feedback(self, feedback: Any) -> None:
         rep = self._reporter
         if rep is not None:
-            rep.emit("feedback", self._path, {"action": self._action_name, "feedback": encode(feedback)})
+            rep.send(build.feedback, self._path, self._action_name, encode(feedback))
         self._feedback_cb.run(self._ud, feedback)

@@ -59,6 +59,7 @@ def main(args: argparse.Namespace) -> int:
     import fsm
     from fsm.control.handle import MachineHandle
     from fsm.logfiles.recorder import Recorder
+    from fsm.observation import schema
     from sim.demo import SimDemo
     from sim.pose import PoseTap
 
@@ -75,7 +76,7 @@ def main(args: argparse.Namespace) -> int:
     def record_pose(fields: dict) -> bool:
         if rep.run is None:  # not started yet: a log opens with the machine's structure
             return False
-        rep.emit("pose", rep.root_path, fields)
+        rep.send(schema.build.pose, rep.root_path, fields["joints"], fields.get("bodies", schema.ABSENT))
         return True
 
     tap = PoseTap(demo.world, record_pose)

@@ -11,6 +11,8 @@ import orjson
 from fastapi import APIRouter, WebSocket
 from starlette.websockets import WebSocketDisconnect
 
+from fsm.observation import schema
+
 from ..auth import websocket_subprotocol
 from ..remote_control import IngestLink
 from .deps import HubDep, refused
@@ -55,8 +57,7 @@ async def ingest(websocket: WebSocket, hub: HubDep) -> None:
                 if problem is None:
                     link.feeds(hub.get(event["machine"]))
                     continue
-                await link.send({"type": "rejected", "reason": problem, "machine": _field(event, "machine"),
-                                 "seq": _field(event, "seq")})
+                await link.send(schema.frame.rejected(problem, _field(event, "machine"), _field(event, "seq")))
     except WebSocketDisconnect:
         return
     finally:

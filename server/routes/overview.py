@@ -14,6 +14,7 @@ import time
 
 from fastapi import APIRouter, Request, WebSocket
 
+from fsm.observation import schema
 from fsm.observation.encoding import dumps
 
 from .. import models
@@ -42,7 +43,7 @@ async def overview_stream(websocket: WebSocket) -> None:
         while not receiver.done():
             frame = tiles()
             if frame != last:
-                await websocket.send_text(dumps({"type": "overview", "now": time.time(), "tiles": frame}).decode())
+                await websocket.send_text(dumps(schema.frame.overview(time.time(), frame)).decode())
                 last = frame
             await asyncio.wait([receiver], timeout=EVERY)
     finally:

@@ -9,6 +9,7 @@ import pytest
 from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
+from fsm.observation import schema
 from server import fanout
 from server.publisher import Publisher
 from server.testing.clients import stalled_stream
@@ -108,6 +109,26 @@ def test_a_client_that_falls_behind_gets_missed_then_a_snapshot(live_server, mon
         got = frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
     assert got[0]["type"] == "missed" and got[0]["count"] > 5
     assert got[1]["status"]["outcome"] == "done"
+
+
+def test_every_frame_the_stream_sends_fits_its_definition_in_the_schema(live_server, monkeypatch):
+    monkeypatch.setattr(fanout, "CLIENT_QUEUE", 2)
+    sm = two_state_machine()
+    entry = live_server.hub.add_local(sm, name="two")
+    sm.execute()  # a run already: a new page's snapshot carries its history
+    with stream(live_server, "two") as ws:
+        got = frames(ws, lambda got: len(got) == 1)
+        [client] = list(entry.clients)
+        client.wake.set = lambda: None  # the sender sleeps through the run: its queue overflows
+        sm.execute()
+        wait_for(lambda: entry.loop_seq == entry.reporter.last_seq)
+        asyncio_set(live_server, client)
+        got += frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
+        monkeypatch.setattr(fanout, "CLIENT_QUEUE", 4000)
+        sm.execute()
+        got += frames(ws, has_terminate)
+    assert "history" in got[0] and {f["type"] for f in got} == {"snapshot", "missed", "events"}
+    assert [schema.frame_problem(f) for f in got] == [None] * len(got)
 
 
 def asyncio_set(srv, client):

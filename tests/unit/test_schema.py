@@ -108,3 +108,33 @@ def test_graph_ids_escape_control_characters_and_percent_one_to_one():
     assert schema.state_id("/SM_ROOT/100%") == "s:/SM_ROOT/100%25"
     assert schema.edge_id("/R", "A\n", "go") == "e:/R:A%0A:go"
     assert schema.state_id("/SM_ROOT/VT%0BBAD") != schema.state_id("/SM_ROOT/VT\x0bBAD")
+
+
+def _names(fields):
+    return {f.name for f in fields}
+
+
+def test_the_reducers_status_holds_the_fields_of_the_schemas_status_and_no_other():
+    from fsm.observation.status import Status
+
+    status = Status("m")
+    for event in (ev(1, "structure", root=flat_root("A", "B")),
+                  ev(2, "start", initial=["A"], active=["A"], userdata={}),
+                  ev(3, "transition", **{"from": "A", "outcome": "go", "to": "B", "active": ["B"]}),
+                  ev(4, "preempt", phase="requested"), ev(5, "pose", joints={"j1": 0.5}),
+                  ev(6, "debug", action="hold", state="B", at="before", outcome=None, reason="pause", detail="paused"),
+                  ev(7, "debug", action="breakpoints", breakpoints=[
+                      {"state": "/SM_ROOT/B", "at": "before", "outcome": None, "when": None}])):
+        status.apply(event)
+    data = status.to_dict()
+    debug = data["debug"]
+    shapes = {"status": (set(data), _names(schema.STATUS_FIELDS)),
+              "container": (set(data["containers"]["/SM_ROOT"]), _names(schema.CONTAINER_STATUS_FIELDS)),
+              "last": (set(data["containers"]["/SM_ROOT"]["last"]), _names(schema.LAST_TRANSITION_FIELDS)),
+              "preempt": (set(data["preempt"]), _names(schema.PREEMPT_FIELDS)),
+              "pose": (set(data["pose"]), _names(schema.POSE_FIELDS)),
+              "debug": (set(debug), _names(schema.DEBUG_STATUS_FIELDS)),
+              "hold": (set(debug["holds"][0]), _names(schema.HOLD_FIELDS)),
+              "breakpoint": (set(debug["breakpoints"][0]), _names(schema.BREAKPOINT_FIELDS))}
+    assert {name: made for name, (made, defined) in shapes.items() if made != defined} == {}
+    assert schema.STATUS.check(data) is None

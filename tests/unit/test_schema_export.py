@@ -1,4 +1,4 @@
-"""The browser's static/schema.js and the tables of docs/events.md are generated from fsm/observation/schema.py
+"""The browser's static/schema.js and the tables of docs/events.md are generated from fsm/observation/schema/
 and must not drift from it."""
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 """What a page can do to a machine of this process: preempt, hold, set its initial state, start it,
-and publish on the in-process bus. The machine's side is fsm/control/handle.py; its calls may block
-briefly on the machine's locks, so they run in a worker thread, never on the event loop."""
+and publish on the in-process bus, through the machine's ``Controls`` (fsm/control/controls.py); the
+calls may block (on the machine's locks, or waiting for its publishing process), so they run in a
+worker thread, never on the event loop."""
 
 from __future__ import annotations
 
@@ -54,10 +55,10 @@ async def publish_topic(topic: Annotated[str, TOPIC], hub: HubDep, client: Clien
                         ) -> models.Delivered:
     def do() -> int:
         delivered = default_bus.publish(topic, message)
-        for entry in hub.machines():
-            if entry.handle is not None and entry.handle.is_running():
-                entry.handle.emit_control("publish", client, "accepted",
-                                          params={"topic": topic, "delivered": delivered})
+        for entry in hub.machines():  # the bus is this process's: its machines record what reached them
+            if entry.local is not None and entry.running():
+                entry.controls.emit_control("publish", client, "accepted",
+                                            params={"topic": topic, "delivered": delivered})
         return delivered
 
     return models.Delivered(delivered=await run_in_threadpool(do))

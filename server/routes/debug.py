@@ -1,48 +1,37 @@
 """The debugger's controls (docs/debugging.md): pause, resume, step, force an outcome, and the
-breakpoints as a set to read and replace. The machine's side is fsm/control/debug.py; its
-calls may block briefly on the debugger's lock, so they run in a worker thread."""
+breakpoints as a set to read and replace, through the machine's ``Controls`` (a local machine's
+debugger is fsm/control/debug.py); the calls may block briefly on the debugger's lock, so they run in a worker thread."""
 
 from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, Depends
+from fastapi import APIRouter, Body
 from fastapi.concurrency import run_in_threadpool
 
-from fsm.control.debug import DebugControl
-
 from .. import models
-from ..remote_control import RemoteHandle
 from .deps import AUTH, ERRORS, LEASED, OPERATOR, ClientAddress, Handle
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["debug"])
 
 
-def get_debug(handle: Handle) -> DebugControl | RemoteHandle:
-    """The debugger's controls of the machine: in this process, or asked of its publishing process."""
-    return handle.debug_control()
-
-
-Debug = Annotated[DebugControl | RemoteHandle, Depends(get_debug)]
-
-
 @router.post("/api/machines/{name}/pause", status_code=202, response_model=models.SeqResponse,
              dependencies=OPERATOR + LEASED,
              description="Hold at the next transition boundary anywhere: the running state runs on until it returns.")
-async def pause(debug: Debug, client: ClientAddress) -> models.SeqResponse:
+async def pause(debug: Handle, client: ClientAddress) -> models.SeqResponse:
     return models.SeqResponse(seq=await run_in_threadpool(debug.pause, client))
 
 
 @router.post("/api/machines/{name}/resume", status_code=202, response_model=models.SeqResponse,
              dependencies=OPERATOR + LEASED)
-async def resume(debug: Debug, client: ClientAddress) -> models.SeqResponse:
+async def resume(debug: Handle, client: ClientAddress) -> models.SeqResponse:
     return models.SeqResponse(seq=await run_in_threadpool(debug.resume, client))
 
 
 @router.post("/api/machines/{name}/step", status_code=202, response_model=models.SeqResponse,
              dependencies=OPERATOR + LEASED,
              description="Let one transition happen, then hold again (409 when the machine is not paused).")
-async def step(debug: Debug, client: ClientAddress,
+async def step(debug: Handle, client: ClientAddress,
                body: Annotated[models.StepRequest | None, Body()] = None) -> models.SeqResponse:
     level = body.level if body is not None else None
     return models.SeqResponse(seq=await run_in_threadpool(debug.step, level, client))
@@ -52,12 +41,12 @@ async def step(debug: Debug, client: ClientAddress,
              dependencies=OPERATOR + LEASED,
              description="The state ends with this outcome: asked to preempt if it runs, taken at once if it holds "
                          "(422 for an unknown state or outcome, 409 when the state is not active).")
-async def force(debug: Debug, client: ClientAddress, body: models.ForceRequest) -> models.SeqResponse:
+async def force(debug: Handle, client: ClientAddress, body: models.ForceRequest) -> models.SeqResponse:
     return models.SeqResponse(seq=await run_in_threadpool(debug.force, body.state, body.outcome, client))
 
 
 @router.get("/api/machines/{name}/breakpoints", response_model=models.Breakpoints)
-async def breakpoints(debug: Debug) -> models.Breakpoints:
+async def breakpoints(debug: Handle) -> models.Breakpoints:
     listed = await run_in_threadpool(debug.breakpoints)  # a remote machine's wait for its publisher's answer
     return models.Breakpoints(breakpoints=[models.BreakpointSpec(**bp) for bp in listed])
 
@@ -65,7 +54,7 @@ async def breakpoints(debug: Debug) -> models.Breakpoints:
 @router.put("/api/machines/{name}/breakpoints", response_model=models.Breakpoints, dependencies=OPERATOR + LEASED,
             description="Replace the whole set, all or none (422 saying which breakpoint is wrong and, for a "
                         "condition, at which column).")
-async def set_breakpoints(debug: Debug, client: ClientAddress, body: models.Breakpoints) -> models.Breakpoints:
+async def set_breakpoints(debug: Handle, client: ClientAddress, body: models.Breakpoints) -> models.Breakpoints:
     specs = [bp.model_dump() for bp in body.breakpoints]
     listed = await run_in_threadpool(debug.set_breakpoints, specs, client)
     return models.Breakpoints(breakpoints=[models.BreakpointSpec(**bp) for bp in listed])

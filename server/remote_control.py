@@ -1,7 +1,8 @@
 """Controls of a machine that another process publishes (``server.publisher.Publisher``): its
 ``fsm.control.Controls``, each call sent as a frame over that process's ingest websocket and answered
-by it (docs/api.md, "Ingest"), or asked of its robot over Zenoh (server/cli/fleet_bridge.py's link). The publishing process applies them to its machine and emits the control
-events in its own stream, so they reach this server, its log and the pages like its other events.
+by it (docs/api.md, "Ingest"), or asked of its robot over Zenoh (server/cli/fleet_bridge.py's link).
+The publishing process applies them to its machine and emits the control events in its own stream,
+so they reach this server, its log and the pages like its other events.
 
 A call waits for the publisher's answer (at most ``ANSWER_TIMEOUT``): like a local control, it runs
 in a worker thread, never on the event loop.
@@ -20,7 +21,7 @@ from pydantic import ValidationError
 from fsm.control.controls import Capabilities, Refused
 from fsm.observation.encoding import dumps
 
-from .models import BreakpointSpec
+from .control_models import BreakpointSpec
 
 if TYPE_CHECKING:
     from .hub import Hub, MachineEntry

@@ -12,7 +12,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from fsm.ros.bus import default_bus
 
-from .. import models
+from ..control_models import Delivered, InitialStateRequest, PreemptRequest, SeqResponse, StartRequest
 from .deps import ERRORS, LEASED, OPERATOR, ClientAddress, Handle, HubDep
 
 router = APIRouter(dependencies=OPERATOR, responses=ERRORS, tags=["control"])
@@ -20,39 +20,39 @@ router = APIRouter(dependencies=OPERATOR, responses=ERRORS, tags=["control"])
 TOPIC = Path(min_length=1, max_length=200, pattern=r"^[A-Za-z0-9_.~/-]+$", description="topic name")
 
 
-@router.post("/api/machines/{name}/preempt", status_code=202, response_model=models.SeqResponse)
+@router.post("/api/machines/{name}/preempt", status_code=202, response_model=SeqResponse)
 async def preempt(handle: Handle, client: ClientAddress,
-                  body: Annotated[models.PreemptRequest | None, Body()] = None) -> models.SeqResponse:
+                  body: Annotated[PreemptRequest | None, Body()] = None) -> SeqResponse:
     reason = body.reason if body is not None else None
-    return models.SeqResponse(seq=await run_in_threadpool(handle.preempt, reason, client))
+    return SeqResponse(seq=await run_in_threadpool(handle.preempt, reason, client))
 
 
-@router.post("/api/machines/{name}/hold", status_code=202, response_model=models.SeqResponse,
+@router.post("/api/machines/{name}/hold", status_code=202, response_model=SeqResponse,
              description="Let the current run finish, then start no other until the next start "
                          "(a machine its host runs in a loop, such as the demo's episodes; 409 otherwise).")
 async def hold(handle: Handle, client: ClientAddress,
-               body: Annotated[models.PreemptRequest | None, Body()] = None) -> models.SeqResponse:
+               body: Annotated[PreemptRequest | None, Body()] = None) -> SeqResponse:
     reason = body.reason if body is not None else None
-    return models.SeqResponse(seq=await run_in_threadpool(handle.hold, reason, client))
+    return SeqResponse(seq=await run_in_threadpool(handle.hold, reason, client))
 
 
-@router.post("/api/machines/{name}/initial-state", response_model=models.SeqResponse, dependencies=LEASED)
-async def initial_state(handle: Handle, client: ClientAddress, body: models.InitialStateRequest) -> models.SeqResponse:
+@router.post("/api/machines/{name}/initial-state", response_model=SeqResponse, dependencies=LEASED)
+async def initial_state(handle: Handle, client: ClientAddress, body: InitialStateRequest) -> SeqResponse:
     seq = await run_in_threadpool(handle.set_initial_state, body.path, list(body.states), dict(body.userdata),
                                   client)
-    return models.SeqResponse(seq=seq)
+    return SeqResponse(seq=seq)
 
 
-@router.post("/api/machines/{name}/start", status_code=202, response_model=models.SeqResponse, dependencies=LEASED)
+@router.post("/api/machines/{name}/start", status_code=202, response_model=SeqResponse, dependencies=LEASED)
 async def start(handle: Handle, client: ClientAddress,
-                body: Annotated[models.StartRequest | None, Body()] = None) -> models.SeqResponse:
-    return models.SeqResponse(seq=await run_in_threadpool(handle.start, client))
+                body: Annotated[StartRequest | None, Body()] = None) -> SeqResponse:
+    return SeqResponse(seq=await run_in_threadpool(handle.start, client))
 
 
-@router.post("/api/topics/{topic}", status_code=202, response_model=models.Delivered)
+@router.post("/api/topics/{topic}", status_code=202, response_model=Delivered)
 async def publish_topic(topic: Annotated[str, TOPIC], hub: HubDep, client: ClientAddress,
                         message: Annotated[Any, Body(description="any JSON value: the message")] = None
-                        ) -> models.Delivered:
+                        ) -> Delivered:
     def do() -> int:
         delivered = default_bus.publish(topic, message)
         for entry in hub.machines():  # the bus is this process's: its machines record what reached them
@@ -61,4 +61,4 @@ async def publish_topic(topic: Annotated[str, TOPIC], hub: HubDep, client: Clien
                                             params={"topic": topic, "delivered": delivered})
         return delivered
 
-    return models.Delivered(delivered=await run_in_threadpool(do))
+    return Delivered(delivered=await run_in_threadpool(do))

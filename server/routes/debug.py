@@ -1,6 +1,7 @@
 """The debugger's controls (docs/debugging.md): pause, resume, step, force an outcome, and the
 breakpoints as a set to read and replace, through the machine's ``Controls`` (a local machine's
-debugger is fsm/control/debug.py); the calls may block briefly on the debugger's lock, so they run in a worker thread."""
+debugger is fsm/control/debug.py); the calls may block briefly on the debugger's lock (or wait for
+a publishing process), so they run in a worker thread."""
 
 from __future__ import annotations
 
@@ -9,52 +10,52 @@ from typing import Annotated
 from fastapi import APIRouter, Body
 from fastapi.concurrency import run_in_threadpool
 
-from .. import models
+from ..control_models import BreakpointSpec, Breakpoints, ForceRequest, SeqResponse, StepRequest
 from .deps import AUTH, ERRORS, LEASED, OPERATOR, ClientAddress, Handle
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["debug"])
 
 
-@router.post("/api/machines/{name}/pause", status_code=202, response_model=models.SeqResponse,
+@router.post("/api/machines/{name}/pause", status_code=202, response_model=SeqResponse,
              dependencies=OPERATOR + LEASED,
              description="Hold at the next transition boundary anywhere: the running state runs on until it returns.")
-async def pause(debug: Handle, client: ClientAddress) -> models.SeqResponse:
-    return models.SeqResponse(seq=await run_in_threadpool(debug.pause, client))
+async def pause(debug: Handle, client: ClientAddress) -> SeqResponse:
+    return SeqResponse(seq=await run_in_threadpool(debug.pause, client))
 
 
-@router.post("/api/machines/{name}/resume", status_code=202, response_model=models.SeqResponse,
+@router.post("/api/machines/{name}/resume", status_code=202, response_model=SeqResponse,
              dependencies=OPERATOR + LEASED)
-async def resume(debug: Handle, client: ClientAddress) -> models.SeqResponse:
-    return models.SeqResponse(seq=await run_in_threadpool(debug.resume, client))
+async def resume(debug: Handle, client: ClientAddress) -> SeqResponse:
+    return SeqResponse(seq=await run_in_threadpool(debug.resume, client))
 
 
-@router.post("/api/machines/{name}/step", status_code=202, response_model=models.SeqResponse,
+@router.post("/api/machines/{name}/step", status_code=202, response_model=SeqResponse,
              dependencies=OPERATOR + LEASED,
              description="Let one transition happen, then hold again (409 when the machine is not paused).")
 async def step(debug: Handle, client: ClientAddress,
-               body: Annotated[models.StepRequest | None, Body()] = None) -> models.SeqResponse:
+               body: Annotated[StepRequest | None, Body()] = None) -> SeqResponse:
     level = body.level if body is not None else None
-    return models.SeqResponse(seq=await run_in_threadpool(debug.step, level, client))
+    return SeqResponse(seq=await run_in_threadpool(debug.step, level, client))
 
 
-@router.post("/api/machines/{name}/force", status_code=202, response_model=models.SeqResponse,
+@router.post("/api/machines/{name}/force", status_code=202, response_model=SeqResponse,
              dependencies=OPERATOR + LEASED,
              description="The state ends with this outcome: asked to preempt if it runs, taken at once if it holds "
                          "(422 for an unknown state or outcome, 409 when the state is not active).")
-async def force(debug: Handle, client: ClientAddress, body: models.ForceRequest) -> models.SeqResponse:
-    return models.SeqResponse(seq=await run_in_threadpool(debug.force, body.state, body.outcome, client))
+async def force(debug: Handle, client: ClientAddress, body: ForceRequest) -> SeqResponse:
+    return SeqResponse(seq=await run_in_threadpool(debug.force, body.state, body.outcome, client))
 
 
-@router.get("/api/machines/{name}/breakpoints", response_model=models.Breakpoints)
-async def breakpoints(debug: Handle) -> models.Breakpoints:
+@router.get("/api/machines/{name}/breakpoints", response_model=Breakpoints)
+async def breakpoints(debug: Handle) -> Breakpoints:
     listed = await run_in_threadpool(debug.breakpoints)  # a remote machine's wait for its publisher's answer
-    return models.Breakpoints(breakpoints=[models.BreakpointSpec(**bp) for bp in listed])
+    return Breakpoints(breakpoints=[BreakpointSpec(**bp) for bp in listed])
 
 
-@router.put("/api/machines/{name}/breakpoints", response_model=models.Breakpoints, dependencies=OPERATOR + LEASED,
+@router.put("/api/machines/{name}/breakpoints", response_model=Breakpoints, dependencies=OPERATOR + LEASED,
             description="Replace the whole set, all or none (422 saying which breakpoint is wrong and, for a "
                         "condition, at which column).")
-async def set_breakpoints(debug: Handle, client: ClientAddress, body: models.Breakpoints) -> models.Breakpoints:
+async def set_breakpoints(debug: Handle, client: ClientAddress, body: Breakpoints) -> Breakpoints:
     specs = [bp.model_dump() for bp in body.breakpoints]
     listed = await run_in_threadpool(debug.set_breakpoints, specs, client)
-    return models.Breakpoints(breakpoints=[models.BreakpointSpec(**bp) for bp in listed])
+    return Breakpoints(breakpoints=[BreakpointSpec(**bp) for bp in listed])

@@ -172,7 +172,7 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return sorted(found)
 
 
-@pytest.mark.parametrize("package", ["fsm", "server"])
+@pytest.mark.parametrize("package", ["fsm", "server", "fleet", "interop", "sim"])
 def test_no_import_cycle_among_a_packages_modules(package):
     assert cycles(import_graph(package)) == []
 

@@ -29,8 +29,11 @@ if TYPE_CHECKING:
 ANSWER_TIMEOUT = 5.0  # seconds a control waits for the publishing process's answer (then 504)
 
 
+NOT_CONNECTED = "the publishing process of %r is not connected: its controls are unavailable"
+
+
 def not_connected(name: str) -> Refused:
-    return Refused(409, "the publishing process of %r is not connected: its controls are unavailable" % name)
+    return Refused(409, NOT_CONNECTED % name)
 
 
 class IngestLink:
@@ -203,7 +206,7 @@ class RemoteHandle:
     def capabilities(self) -> Capabilities:
         link = self.link
         if link is None or link.closed:
-            return Capabilities(unavailable=not_connected(self.name).message)
+            return Capabilities(unavailable=NOT_CONNECTED % self.name)
         cannot = {"hold": "the publishing process of %r does not say whether it runs the machine in a loop"
                           % self.name}
         if not link.controllable.get(self.name, False):

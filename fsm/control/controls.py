@@ -9,7 +9,8 @@ the message the operator reads; a server maps ``Refused`` to HTTP in one place.
 
 A kind of machine that cannot do something says so in its ``capabilities()`` (with why, the
 message its refusal carries), so a page can grey the button out before anyone presses it; the
-call itself still refuses, and records that it did.
+call itself still refuses (``Refused(409, why)``), and records that it did when it can.
+tests/test_controls.py checks that every kind has every call with the protocol's parameters.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ from fastapi.concurrency import run_in_threadpool
 from fsm.ros.bus import default_bus
 
 from ..control_models import Delivered, InitialStateRequest, PreemptRequest, SeqResponse, StartRequest
-from .deps import ERRORS, LEASED, OPERATOR, ClientAddress, Handle, HubDep
+from .deps import ERRORS, LEASED, OPERATOR, ClientAddress, HubDep, MachineControls
 
 router = APIRouter(dependencies=OPERATOR, responses=ERRORS, tags=["control"])
 
@@ -21,32 +21,33 @@ TOPIC = Path(min_length=1, max_length=200, pattern=r"^[A-Za-z0-9_.~/-]+$", descr
 
 
 @router.post("/api/machines/{name}/preempt", status_code=202, response_model=SeqResponse)
-async def preempt(handle: Handle, client: ClientAddress,
+async def preempt(controls: MachineControls, client: ClientAddress,
                   body: Annotated[PreemptRequest | None, Body()] = None) -> SeqResponse:
     reason = body.reason if body is not None else None
-    return SeqResponse(seq=await run_in_threadpool(handle.preempt, reason, client))
+    return SeqResponse(seq=await run_in_threadpool(controls.preempt, reason, client))
 
 
 @router.post("/api/machines/{name}/hold", status_code=202, response_model=SeqResponse,
              description="Let the current run finish, then start no other until the next start "
                          "(a machine its host runs in a loop, such as the demo's episodes; 409 otherwise).")
-async def hold(handle: Handle, client: ClientAddress,
+async def hold(controls: MachineControls, client: ClientAddress,
                body: Annotated[PreemptRequest | None, Body()] = None) -> SeqResponse:
     reason = body.reason if body is not None else None
-    return SeqResponse(seq=await run_in_threadpool(handle.hold, reason, client))
+    return SeqResponse(seq=await run_in_threadpool(controls.hold, reason, client))
 
 
 @router.post("/api/machines/{name}/initial-state", response_model=SeqResponse, dependencies=LEASED)
-async def initial_state(handle: Handle, client: ClientAddress, body: InitialStateRequest) -> SeqResponse:
-    seq = await run_in_threadpool(handle.set_initial_state, body.path, list(body.states), dict(body.userdata),
+async def initial_state(controls: MachineControls, client: ClientAddress,
+                        body: InitialStateRequest) -> SeqResponse:
+    seq = await run_in_threadpool(controls.set_initial_state, body.path, list(body.states), dict(body.userdata),
                                   client)
     return SeqResponse(seq=seq)
 
 
 @router.post("/api/machines/{name}/start", status_code=202, response_model=SeqResponse, dependencies=LEASED)
-async def start(handle: Handle, client: ClientAddress,
+async def start(controls: MachineControls, client: ClientAddress,
                 body: Annotated[StartRequest | None, Body()] = None) -> SeqResponse:
-    return SeqResponse(seq=await run_in_threadpool(handle.start, client))
+    return SeqResponse(seq=await run_in_threadpool(controls.start, client))
 
 
 @router.post("/api/topics/{topic}", status_code=202, response_model=Delivered)

@@ -51,7 +51,7 @@ def get_controls(entry: Machine) -> Controls:
     return controls
 
 
-Handle = Annotated[Controls, Depends(get_controls)]
+MachineControls = Annotated[Controls, Depends(get_controls)]
 
 
 PAGE_HEADER = "x-fsmscope-page"  # the page a request comes from (static/api.js PAGE_ID): who holds a lease
@@ -88,7 +88,8 @@ def get_leases(connection: HTTPConnection) -> LeaseControl:
 Leases = Annotated[LeaseControl, Depends(get_leases)]
 
 
-def require_lease(entry: Machine, handle: Handle, page: Page, client: ClientAddress, leases: Leases) -> None:
+def require_lease(entry: Machine, controls: MachineControls, page: Page, client: ClientAddress,
+                  leases: Leases) -> None:
     """Dependency of a control that needs the operator lease (server/lease.py): 409 saying who holds it
     when another page does; a page's first control takes a free one."""
     try:

@@ -11,7 +11,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from ..control_models import Deadman, LeaseHolder, LeaseRequest, LeaseState
 from ..lease import BEAT_EVERY, Lease, LeaseHeld, short
-from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Handle, Leases, Machine, Page
+from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Leases, Machine, MachineControls, Page
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["lease"])
 
@@ -43,7 +43,7 @@ async def lease(entry: Machine, leases: Leases, page: Page) -> LeaseState:
 @router.post("/api/machines/{name}/lease", response_model=LeaseState, dependencies=OPERATOR,
              description="Take control of the machine (409 saying who holds it, unless `takeover`: then "
                          "the other page loses it, and the event says so).")
-async def take(entry: Machine, handle: Handle, leases: Leases, page: Page, client: ClientAddress,
+async def take(entry: Machine, controls: MachineControls, leases: Leases, page: Page, client: ClientAddress,
                body: Annotated[LeaseRequest | None, Body()] = None) -> LeaseState:
     page = _needs_page(page)
     takeover = body.takeover if body is not None else False
@@ -68,7 +68,7 @@ async def beat(entry: Machine, leases: Leases, page: Page) -> LeaseState:
 
 @router.delete("/api/machines/{name}/lease", response_model=LeaseState, dependencies=OPERATOR,
                description="Give control up (nothing happens to the machine).")
-async def release(entry: Machine, handle: Handle, leases: Leases, page: Page, client: ClientAddress
+async def release(entry: Machine, controls: MachineControls, leases: Leases, page: Page, client: ClientAddress
                   ) -> LeaseState:
     page = _needs_page(page)
     if not await run_in_threadpool(leases.release, entry, page, client):

@@ -110,7 +110,7 @@ def fsmscope_run(n_clients, n_events, rate):
     url = "ws://127.0.0.1:%d/api/machines/bench/stream?token=%s" % (srv.port, srv.token)
     proc, out = run_clients(url, n_clients, n_events)
     time.sleep(0.3)
-    emit_paced(entry.reporter, "/SM_ROOT", n_events, rate)
+    emit_paced(entry.local.reporter, "/SM_ROOT", n_events, rate)
     results = out.get(timeout=120)
     proc.join(10)
     srv.stop()
@@ -256,8 +256,8 @@ def stall_memory(seconds):
         samples.append(rss_mb())
     stop.set()
     thread.join(10)
-    events = entry.reporter.last_seq
-    clients = len(entry.clients)
+    events = entry.local.reporter.last_seq
+    clients = len(entry.feed.clients)
     raw.close()
     srv.stop()
     return before, samples, events, clients

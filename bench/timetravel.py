@@ -34,8 +34,9 @@ from fsm.logfiles.log_reader import read_events  # noqa: E402
 from replay import REPEATS, generate, median_time  # noqa: E402  (bench/replay.py's 1M-event recording)
 import table  # noqa: E402
 from table import verdict  # noqa: E402
+from server.feed import Feed  # noqa: E402
 from server.history import History  # noqa: E402
-from server.fanout import Feed  # noqa: E402
+from server.log_history import LogHistory  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
 from server.timeline import TimelineIndex  # noqa: E402
 
@@ -64,7 +65,7 @@ def serve(path: str) -> ServerThread:
     srv = ServerThread()
     first = next(read_events(path))
     srv.hub.ingest(first, "replay")
-    srv.hub.get(MACHINE).history = History.from_log(path, MACHINE)
+    srv.hub.get(MACHINE).read_past_from(LogHistory(path, MACHINE))
     return srv.start()
 
 
@@ -96,18 +97,11 @@ def server_rows(http: httpx.Client, path: str, last: int) -> list[Row]:
     ]
 
 
-class NoIndex:
-    """A feed's timeline switched off, to see what the index costs."""
-
-    def add(self, event: dict) -> None:
-        pass
-
-
 def observing(events: list[dict], indexed: bool) -> Callable[[], None]:
     def observe() -> None:
         feed = Feed(MACHINE)
-        if not indexed:
-            feed.timeline = NoIndex()
+        if indexed:
+            feed.add_sink(TimelineIndex().add)
         for event in events:
             feed.observe(event)
     return observe

@@ -18,7 +18,7 @@ from fastapi.staticfiles import StaticFiles
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from swagger_ui_bundle import swagger_ui_path
 
-from fsm.control.handle import ControlError
+from fsm.control.controls import Refused
 
 from .hub import Hub
 from .lease import Deadman, Leases
@@ -57,7 +57,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(RequestValidationError, _validation_error)
     app.add_exception_handler(Exception, _unexpected_error)
-    app.add_exception_handler(ControlError, _control_error)
+    app.add_exception_handler(Refused, _refused)
     app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")  # for pages.docs
     for module in (pages, machines, overview, history, timeline, control, debug, lease, scene, stream, ingest):
         app.include_router(module.router)
@@ -90,7 +90,8 @@ async def _unexpected_error(request: Request, exc: Exception) -> JSONResponse:
     return JSONResponse({"detail": "internal error (%s)" % type(exc).__name__}, status_code=500)
 
 
-async def _control_error(request: Request, exc: ControlError) -> JSONResponse:
+async def _refused(request: Request, exc: Refused) -> JSONResponse:
+    """What a machine's controls or its history refused (fsm/control/controls.py), with its status."""
     return JSONResponse({"detail": exc.message}, status_code=exc.status)
 
 

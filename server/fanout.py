@@ -1,13 +1,9 @@
 """The fan-out: how a machine's events get from its thread to every browser that watches it.
 
-Threads: the machine's reporter calls the machine's ``Observer`` in the machine's thread. It
-applies the event to the ``Feed``'s Status there (under the feed's lock, so the Status is never
-behind the machine and never depends on the loop keeping up), encodes it, and appends the encoded
-event to the feed's bounded hand-off buffer; the ``Fanout`` wakes the event loop with
-``call_soon_threadsafe`` when no wake-up is pending. When the loop does not drain fast enough and
-the buffer holds ``HANDOFF_LIMIT`` events, the buffered events are dropped (counted): the ring then
-has a gap, and every client behind it is sent ``missed`` and a snapshot, taken from the Status,
-which is always complete. The loop owns the ring and the clients; it reads the Status under the lock.
+Threads: the machine's reporter calls the machine's ``Observer`` in the machine's thread, which
+gives the event to its ``feed.Feed`` (the Status, the hand-off, the ring: server/feed.py); the
+``Fanout`` wakes the event loop with ``call_soon_threadsafe`` when no wake-up is pending, and the
+loop takes the hand-off into the ring. The loop owns the ring and the clients.
 
 Every event is encoded once, into the machine's ring of recent events; a client is a cursor into
 that ring, so the per-event work on the loop does not depend on how many clients there are, and
@@ -19,8 +15,8 @@ and its socket aborted (a clean close would wait for the unsent data of a stalle
 may ask for a pace (``Client.repace``): at most one frame per that many seconds, each with every
 event since the last (a page looking back needs only its count of events behind).
 
-This module is one piece (about 350 lines) because the feed, its clients' cursors and
-the sender loop share one invariant: what the ring holds, and which client still needs what.
+The clients' cursors and the sender loop are one piece: they share one invariant, which client
+still needs what of the ring.
 """
 
 from __future__ import annotations
@@ -28,183 +24,21 @@ from __future__ import annotations
 import asyncio
 import collections
 import contextlib
-import threading
 import time
 from typing import Any, Callable
 
 from fsm.observation import schema
-from fsm.observation.encoding import dumps, encoded
-from fsm.observation.status import Status
+from fsm.observation.encoding import dumps
 
-from .history import status_answer
-from .timeline import TimelineIndex
+from .feed import Feed
 
-RING_SIZE = 20000          # recent events kept per machine for since=SEQ
 CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a snapshot instead
 MAX_BATCH = 1000           # events per frame at most (a paced client: up to CLIENT_QUEUE)
 MAX_PACE = schema.MAX_PACE_MS / 1000  # s: the slowest pace a client may ask for
-HISTORY = schema.HISTORY_LIMIT  # events of the current run a new client is sent for its log, at most
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
-HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
-KEYFRAME_EVERY = 1000      # a copy of the Status every this many events, for the status at a seq the ring holds
 DRAIN_INTERVAL = 0.02      # s after a drain during which machine threads hand over without waking the loop
 
 _FRAME_HEAD, _FRAME_TAIL = schema.list_frame("events")
-
-
-class Feed:
-    """One machine's stream: its Status, the hand-off from its threads, the ring of encoded events, its clients."""
-
-    def __init__(self, name: str) -> None:
-        self.status = Status(name)
-        self.lock = threading.Lock()  # guards the Status (applied in machine threads) and the hand-off
-        self.handoff: collections.deque[tuple[int, bytes]] = collections.deque()  # machine thread -> loop
-        self.dropped = 0  # events dropped from the hand-off since the loop last drained it
-        self.queued = False  # the feed waits in the fan-out's ready queue
-        self.ring: collections.deque[tuple[int, bytes]] = collections.deque(maxlen=RING_SIZE)
-        # (seq, Status.to_dict() after it), taken as events are applied; as many as span the ring (server/history.py)
-        self.keyframes: collections.deque[tuple[int, dict]] = collections.deque(
-            maxlen=RING_SIZE // KEYFRAME_EVERY + 2)
-        self.next_keyframe = 0  # the first event applied takes one of the state before it
-        self.loop_seq = 0  # the seq of the newest event the loop has taken (the ring's end, gaps or not)
-        self.clients: set[Client] = set()
-        self.idle: set[Client] = set()  # clients whose sender waits for the next event
-        self._snapshot: tuple[int, int, str] | None = None  # (id(status), last_seq, frame)
-        self.timeline = TimelineIndex()
-        # Another consumer of the encoded events, given each (seq, JSON) in the machine's thread: a
-        # Zenoh robot publishing the machine (fleet.robot.ZenohRobot.follow, composed by the CLI).
-        self.tap: Callable[[tuple[int, bytes]], None] | None = None
-
-    # In the machine's thread.
-    def observe(self, event: dict) -> bool:
-        """Apply, encode (once for every observer: fsm.observation.encoding.encoded), hand over; True
-        when the loop must be told."""
-        item = (event["seq"], encoded(event))
-        self.timeline.add(event)
-        if self.tap is not None:
-            self.tap(item)
-        with self.lock:
-            if event["seq"] >= self.next_keyframe:
-                self.keyframe()
-            self.status.apply(event)
-            handoff = self.handoff
-            if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
-                self.dropped += len(handoff)
-                handoff.clear()
-            handoff.append(item)
-            if self.queued:
-                return False
-            self.queued = True
-            return True
-
-    # On the loop.
-    def take_handoff(self) -> None:
-        """Move what the machine threads handed over into the ring; wake idle senders."""
-        with self.lock:
-            items, self.handoff = self.handoff, collections.deque()
-            dropped, self.dropped = self.dropped, 0
-            self.queued = False
-        if not items:
-            return
-        if dropped:  # a gap: clients whose cursor falls in it are sent missed + a snapshot
-            self.ring.clear()
-        self.ring.extend(items)
-        self.loop_seq = items[-1][0]
-        if self.idle:
-            self.wake_idle()
-
-    def apply(self, event: dict) -> None:
-        """An event from another process: update the Status, keep the event (encoded once), wake idle senders."""
-        with self.lock:
-            if event["seq"] >= self.next_keyframe:
-                self.keyframe()
-            self.status.apply(event)
-        self.timeline.add(event)
-        self.ring.append((event["seq"], dumps(event)))
-        self.loop_seq = event["seq"]
-        if self.idle:
-            self.wake_idle()
-
-    def reset(self, status: Status) -> None:
-        """A new epoch (an ingesting process restarted, or sent a snapshot): clients start over."""
-        if status.last_seq < self.status.last_seq:  # restarted: its seqs begin again
-            self.timeline = TimelineIndex()
-        with self.lock:
-            self.status = status
-            self.keyframes.clear()
-            self.keyframe()
-        self.ring.clear()
-        self.loop_seq = status.last_seq
-        for client in self.clients:
-            client.need_snapshot = True
-        self.wake_idle()
-
-    def keyframe(self) -> None:
-        """Keep a copy of the Status as it is now (holding the lock), for the status at a past seq."""
-        status = self.status
-        self.keyframes.append((status.last_seq, status.to_dict()))
-        self.next_keyframe = status.last_seq + KEYFRAME_EVERY
-
-    def wake_idle(self) -> None:
-        idle = self.idle
-        if idle:
-            for client in idle:
-                client.wake.set()
-            idle.clear()
-
-    def status_dict(self) -> dict:
-        """GET .../status's answer for the Status now (``history.status_answer``), consistent: machine
-        threads apply events to it concurrently."""
-        with self.lock:
-            return status_answer(self.status)
-
-    def snapshot(self) -> tuple[int, str]:
-        """(last_seq, the snapshot frame): built once per state, shared by every client that needs it."""
-        with self.lock:
-            status = self.status
-            cached = self._snapshot
-            if cached is not None and cached[0] == id(status) and cached[1] == status.last_seq:
-                return cached[1], cached[2]
-            data = status.to_dict()
-            key = (id(status), status.last_seq)
-        frame = dumps(schema.frame.snapshot(data, key[1])).decode()
-        self._snapshot = (key[0], key[1], frame)
-        return key[1], frame
-
-    def run_history(self, upto: int) -> bytes:
-        """The current run's events up to ``upto`` (from the ring, the newest ``HISTORY`` at most), as a
-        snapshot's encoded ``history``; its ``complete`` says whether it reaches back to the run's start."""
-        with self.lock:
-            start = self.status.run_seq
-        ring = self.ring
-        first = ring[0][0] if ring else upto + 1
-        events = [data for seq, data in ring if start <= seq <= upto]
-        complete = first <= start and len(events) <= HISTORY
-        return schema.encoded_history(complete, events[-HISTORY:])
-
-    def keeps_after(self, since: int) -> bool:
-        """Whether the ring still holds every event after ``since`` (a client can resume from there)."""
-        return since <= self.status.last_seq and self.encoded_from(since + 1, 1) is not None
-
-    def encoded_from(self, seq: int, limit: int) -> list[bytes] | None:
-        """Up to ``limit`` encoded events from ``seq`` on; None when ``seq`` is no longer kept."""
-        ring = self.ring
-        if seq > self.loop_seq:
-            return []
-        if not ring:
-            return None
-        first = ring[0][0]
-        if seq < first:
-            return None
-        idx = seq - first
-        if idx >= len(ring) or ring[idx][0] != seq:  # seqs with a gap: find it the slow way
-            for idx, (s, _) in enumerate(ring):
-                if s >= seq:
-                    break
-            else:
-                return []
-        stop = min(len(ring), idx + limit)
-        return [ring[i][1] for i in range(idx, stop)]
 
 
 class Client:

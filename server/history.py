@@ -1,14 +1,15 @@
 """A machine's past: the status after any event, and its events page by page (docs/api.md, "Time travel").
 
-``History`` (one per hub entry, ``entry.history``) answers from two places:
+``History`` (one per hub entry, ``entry.past``) answers from two places:
 
-* memory: the feed's ring of encoded events (fanout.Feed.ring, the newest ``RING_SIZE``) and its
-  keyframes (a ``Status.to_dict()`` every ``KEYFRAME_EVERY`` events, fanout.Feed.keyframes), so
-  the recent past costs at most one keyframe copy plus ``KEYFRAME_EVERY`` events to apply;
+* memory: the feed's ring of encoded events (feed.Feed.ring, the newest ``RING_SIZE``) and the
+  ``Keyframes`` it keeps of the feed's Status (a ``Status.to_dict()`` every ``KEYFRAME_EVERY``
+  events, taken as the feed applies them), so the recent past costs at most one keyframe copy plus
+  ``KEYFRAME_EVERY`` events to apply;
 * disk, for anything older: the recording, read by ``LogHistory(path, machine)``
   (server/log_history.py).
 
-Without a recording, history reaches back as far as the ring: older seqs answer ``HistoryError``
+Without a recording, history reaches back as far as the ring: older seqs are ``Refused``
 410 "history reaches back to seq X". The loop owns the ring, so ``History.view()`` copies what
 memory holds (references only) on the loop, and the copy (``HistoryView``) does the work anywhere,
 a route's thread pool included. A page or a seek crosses from one to the other at the seam
@@ -18,44 +19,47 @@ a route's thread pool included. A page or a seek crosses from one to the other a
 from __future__ import annotations
 
 import bisect
+import collections
 import os
 from dataclasses import dataclass
 from operator import itemgetter
 from typing import TYPE_CHECKING, Any, Iterator
 
+from fsm.control.controls import Refused
 from fsm.observation.encoding import dumps, loads
 from fsm.observation.status import Status
 
+from .feed import RING_SIZE, status_answer
 from .log_history import Found, LogHistory
 
 if TYPE_CHECKING:
-    from .fanout import Feed
+    from .feed import Feed
 
 SCAN_BUDGET = 200_000  # events of the machine one page examines at most; beyond, it stops with more/next
 MAX_LIMIT = 10_000  # events per page at most
 DEFAULT_LIMIT = 1000
+KEYFRAME_EVERY = 1000  # a copy of the Status every this many events, for the status at a seq the ring holds
 
 _seq_of = itemgetter(0)
 
 
-class HistoryError(Exception):
-    """A question history cannot answer: ``status`` is the HTTP status (410, 416, 422)."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
-
-
-def status_answer(status: Status) -> dict:
-    """What GET .../status answers for ``status``: its dict without the structure, with ``preempt_waiting_on``."""
-    data = status.to_dict()
-    data.pop("structure", None)
-    data["preempt_waiting_on"] = status.preempt_waiting_on()
-    return data
-
-
 # Memory, and the two together.
+
+class Keyframes:
+    """Copies of a feed's Status, (seq, ``Status.to_dict()`` after it), one every ``KEYFRAME_EVERY``
+    events: as many as span the ring. The feed calls ``keep`` holding its lock (``Feed.keep_status``)."""
+
+    def __init__(self) -> None:
+        self.kept: collections.deque[tuple[int, dict]] = collections.deque(maxlen=RING_SIZE // KEYFRAME_EVERY + 2)
+
+    def keep(self, status: Status, fresh: bool) -> int:
+        """Keep a copy of ``status`` as it is now (``fresh``: a new epoch, the older ones go); returns the
+        seq before which the next is wanted."""
+        if fresh:
+            self.kept.clear()
+        self.kept.append((status.last_seq, status.to_dict()))
+        return status.last_seq + KEYFRAME_EVERY
+
 
 @dataclass(frozen=True)
 class Recent:
@@ -67,11 +71,11 @@ class Recent:
     last: int  # the newest event the ring holds
 
     @classmethod
-    def of(cls, feed: Feed) -> Recent:
+    def of(cls, feed: Feed, kept: Keyframes) -> Recent:
         """On the loop (which owns the ring), after ``Fanout.flush``."""
         ring = list(feed.ring)
         with feed.lock:
-            keyframes = list(feed.keyframes) or [(feed.status.last_seq, feed.status.to_dict())]
+            keyframes = list(kept.kept) or [(feed.status.last_seq, feed.status.to_dict())]
         last = feed.loop_seq
         ring_first = ring[0][0] if ring else None
         # A keyframe is usable when every event after it is in the ring (and the ring is not behind it).
@@ -149,13 +153,13 @@ class HistoryView:
     def status_at(self, seq: int | None = None, t: float | None = None) -> dict:
         """GET .../status?seq= (or ?t=): the status after event ``seq`` (or the last one at or before ``t``)."""
         if (seq is None) == (t is None):
-            raise HistoryError(422, "give seq or t, not both")
+            raise Refused(422, "give seq or t, not both")
         span = self.span()
         if t is not None:
             seq = self.seq_at(t)
         first, last = span["first_seq"], span["last_seq"]
         if last is None or seq > last:
-            raise HistoryError(416, "seq %d is beyond the last event (%s)" % (seq, "none" if last is None else last))
+            raise Refused(416, "seq %d is beyond the last event (%s)" % (seq, "none" if last is None else last))
         if first is None or seq < first:
             raise _gone(first)
         recent = self.recent
@@ -174,8 +178,8 @@ class HistoryView:
         if seq is None:
             first = self.span()["first_seq"]
             if first is None:
-                raise HistoryError(416, "there are no events yet")
-            raise HistoryError(410, "t %r is before what history keeps: it reaches back to seq %d" % (t, first))
+                raise Refused(416, "there are no events yet")
+            raise Refused(410, "t %r is before what history keeps: it reaches back to seq %d" % (t, first))
         return seq
 
     def page(self, since: int | None = None, until: int | None = None, limit: int = DEFAULT_LIMIT,
@@ -184,9 +188,9 @@ class HistoryView:
         ``order="desc"``: the newest ``limit`` of the range (still oldest first), for paging backwards.
         ``next`` is the ``since`` (asc) or ``until`` (desc) of the next page."""
         if not 1 <= limit <= MAX_LIMIT:
-            raise HistoryError(422, "limit must be between 1 and %d" % MAX_LIMIT)
+            raise Refused(422, "limit must be between 1 and %d" % MAX_LIMIT)
         if since is not None and until is not None and since > until:
-            raise HistoryError(422, "since (%d) is after until (%d)" % (since, until))
+            raise Refused(422, "since (%d) is after until (%d)" % (since, until))
         span = self.span()
         first, last = span["first_seq"], span["last_seq"]
         if first is None or last is None:
@@ -241,18 +245,22 @@ class HistoryView:
             yield from in_memory
 
 
-def _gone(first: int | None) -> HistoryError:
+def _gone(first: int | None) -> Refused:
     if first is None:
-        return HistoryError(410, "no history is kept yet")
-    return HistoryError(410, "history reaches back to seq %d" % first)
+        return Refused(410, "no history is kept yet")
+    return Refused(410, "history reaches back to seq %d" % first)
 
 
 class History:
-    """A hub entry's history: its feed's recent past (``feed``, None for a log alone) and its recording (``log``)."""
+    """A hub entry's history: its feed's recent past (``feed``, None for a log alone: then it keeps no
+    keyframes of it) and its recording (``log``)."""
 
     def __init__(self, feed: Feed | None = None, log: LogHistory | None = None) -> None:
         self.feed = feed
         self.log = log
+        self.keyframes = Keyframes()
+        if feed is not None:
+            feed.keep_status(self.keyframes.keep)
 
     @classmethod
     def from_log(cls, path: str | os.PathLike, machine: str) -> History:
@@ -261,7 +269,7 @@ class History:
 
     def view(self) -> HistoryView:
         """On the loop, after ``Fanout.flush()``: a copy of what memory holds (references; cheap)."""
-        return HistoryView(Recent.of(self.feed) if self.feed is not None else None, self.log)
+        return HistoryView(Recent.of(self.feed, self.keyframes) if self.feed is not None else None, self.log)
 
     # The same questions, for callers on the loop (tests, the CLI): the routes use a view in a thread.
     def span(self) -> dict:

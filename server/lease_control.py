@@ -12,11 +12,11 @@ import sys
 import traceback
 from typing import Any
 
+from fsm.control.controls import Controls
+from fsm.control.frames import apply_deadman
+
 from .hub import Hub, MachineEntry
 from .lease import Lease, Leases, short
-from fsm.control.frames import apply_deadman
-from fsm.control.handle import MachineHandle
-from .remote_control import RemoteHandle
 
 DEADMAN = "deadman"  # the client of what the deadman does
 SWEEP_EVERY = 0.25  # seconds between two looks for lapsed leases
@@ -78,10 +78,10 @@ class LeaseControl:
             except Exception:
                 sys.stderr.write("fsmscope: the deadman's sweep failed:\n" + traceback.format_exc())
 
-    def _handle(self, name: str) -> MachineHandle | RemoteHandle | None:
-        """The machine's handle: in this process, or its publisher's (remote_control.py)."""
+    def _handle(self, name: str) -> Controls | None:
+        """The machine's controls, whatever kind of machine it is."""
         entry = self.hub.get(name)
-        return None if entry is None else entry.handle or entry.remote
+        return None if entry is None else entry.controls
 
     def _changed(self, entry: MachineEntry, client: str, params: dict, held: bool) -> None:
         handle = self._handle(entry.name)

@@ -1,4 +1,6 @@
-"""Request and response models of the REST API (docs/api.md); OpenAPI is generated from these.
+"""What the REST API says of machines (docs/api.md): the list, the tiles, a structure, a status, a page of
+history, a timeline, the states' statistics, and the few answers of the pages; OpenAPI is generated
+from these. The controls' requests and answers are server/control_models.py.
 
 The shapes the schema defines (fsm/observation/schema/: a machine's status and what it holds, a
 breakpoint, a structure node) are restated here for OpenAPI's sake, with their descriptions, and
@@ -10,7 +12,7 @@ from typing import Any, Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from fsm.observation.schema import DEADMAN_ACTIONS, SOURCES
+from fsm.observation.schema import SOURCES
 
 JsonValue = Any
 
@@ -159,6 +161,16 @@ class PendingPreempt(BaseModel):
     serviced: list[str] = Field(description="the states that serviced it so far")
 
 
+class BreakpointSpec(BaseModel):
+    model_config = ConfigDict(extra="forbid")
+
+    state: str = Field(max_length=4096, description="the state's path")
+    at: str = Field(default="before", description="'before' it runs or 'after' it returned")
+    outcome: Optional[str] = Field(default=None, max_length=1000, description="after: only this outcome")
+    when: Optional[str] = Field(default=None, max_length=1000, description="a condition over its container's "
+                                "userdata (docs/debugging.md): comparisons, and/or/not, in, len(), literals")
+
+
 class Hold(BaseModel):
     path: str = Field(description="the holding container")
     state: str
@@ -300,91 +312,6 @@ class StateSummary(BaseModel):
     complete: bool = Field(description="every event up to last_seq is counted (else ask again: at most 100,000 more "
                                        "are read per request)")
     states: dict[str, StateStatistics] = Field(description="by state path: the one asked, or every state visited")
-
-
-class PreemptRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    reason: Optional[str] = Field(default=None, max_length=1000)
-
-
-class InitialStateRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    path: Optional[str] = Field(default=None, max_length=2000, description="container path; default: the root")
-    states: list[str] = Field(default_factory=list, max_length=100)
-    userdata: dict[str, JsonValue] = Field(default_factory=dict)
-
-
-class StartRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-
-class StepRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"level": None}, {"level": "/SM_ROOT"}]})
-
-    level: Optional[str] = Field(default=None, max_length=4096, description="a container's path: hold again at "
-                                 "its next transition (a step over what runs inside it); null: the next anywhere")
-
-
-class ForceRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
-        {"state": "/SM_ROOT/PICK", "outcome": "succeeded"}]})
-
-    state: str = Field(max_length=4096, description="an active (or holding) state's path")
-    outcome: str = Field(max_length=1000, description="one of its registered outcomes")
-
-
-class BreakpointSpec(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    state: str = Field(max_length=4096, description="the state's path")
-    at: str = Field(default="before", description="'before' it runs or 'after' it returned")
-    outcome: Optional[str] = Field(default=None, max_length=1000, description="after: only this outcome")
-    when: Optional[str] = Field(default=None, max_length=1000, description="a condition over its container's "
-                                "userdata (docs/debugging.md): comparisons, and/or/not, in, len(), literals")
-
-
-class Breakpoints(BaseModel):
-    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [{"breakpoints": [
-        {"state": "/SM_ROOT/PICK/CLOSE", "at": "before", "when": "attempts > 2"},
-        {"state": "/SM_ROOT/PLACE", "at": "after", "outcome": "aborted"}]}]})
-
-    breakpoints: list[BreakpointSpec] = Field(max_length=1000, description="the whole set")
-
-
-class LeaseHolder(BaseModel):
-    page: str = Field(description="the first characters of the holder page's id")
-    client: str = Field(description="where it asked from")
-    since: float = Field(description="when it took control (seconds since the epoch)")
-
-
-class Deadman(BaseModel):
-    after: float = Field(description="seconds without a heartbeat from the holder before the action")
-    action: Literal[DEADMAN_ACTIONS]  # type: ignore[valid-type]
-
-
-class LeaseState(BaseModel):
-    """Who controls a machine (docs/debugging.md, "One operator at a time")."""
-
-    holder: Optional[LeaseHolder] = Field(default=None, description="null: nobody; a page's first control takes it")
-    yours: bool = Field(default=False, description="the page that asked (X-Fsmscope-Page) holds it")
-    deadman: Deadman
-    beat_every: float = Field(description="seconds between the holder page's heartbeats")
-
-
-class LeaseRequest(BaseModel):
-    model_config = ConfigDict(extra="forbid")
-
-    takeover: bool = Field(default=False, description="take it even when another page holds it (recorded)")
-
-
-class SeqResponse(BaseModel):
-    seq: int = Field(description="seq of the control event this request caused")
-
-
-class Delivered(BaseModel):
-    delivered: int = Field(description="subscribers reached")
 
 
 StructureNode.model_rebuild()

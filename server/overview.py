@@ -27,12 +27,12 @@ def state_of(entry: MachineEntry) -> str:
     outcome), running, idle (not started yet), or gone: its process went away while it ran or idled,
     so nobody can tell what it does now. A run that ended stays failed or done when its process goes
     (the tile's ``connected`` says it is gone too)."""
-    status = entry.status
+    status = entry.feed.status
     if status.outcome is not None and not status.running:
         return "done"
     if status.error is not None and not status.running:
         return "failed"
-    if entry.connected is False:
+    if entry.origin.gone:
         return "gone"
     return "running" if entry.running() else "idle"
 
@@ -56,8 +56,9 @@ class Overview:
         return [self._tile(entry, now, wall) for entry in entries]
 
     def _tile(self, entry: MachineEntry, now: float, wall: float) -> dict:
-        with entry.lock:  # a local machine's thread applies its events
-            status = entry.status
+        feed = entry.feed
+        with feed.lock:  # a local machine's thread applies its events
+            status = feed.status
             seq, last_t, outcome, error = status.last_seq, status.last_t, status.outcome, status.error or {}
             active = status.active_leaves() if status.structure is not None else []
         samples = self._samples.setdefault(entry.name, collections.deque())
@@ -71,8 +72,9 @@ class Overview:
             # First sight: when its newest event was made (never later than now); then: when it changed.
             seen = (seq, min(last_t or wall, wall) if seen is None else wall)
             self._seen[entry.name] = seen
-        return {"name": entry.name, "robot": entry.robot, "machine": entry.name.partition(":")[2] if entry.robot
-                else entry.name, "source": entry.source, "state": state_of(entry), "outcome": outcome,
+        origin = entry.origin
+        return {"name": entry.name, "robot": origin.robot, "machine": entry.name.partition(":")[2] if origin.robot
+                else entry.name, "source": origin.source, "state": state_of(entry), "outcome": outcome,
                 "error": error.get("exc_type") or error.get("message") or None, "active": active,
                 "rate": round(rate, 1), "last_seq": seq, "last_seen": seen[1] if seq else None,
-                "connected": entry.connected is not False}
+                "connected": not origin.gone}

@@ -1,7 +1,8 @@
-"""Controls of a machine that another process publishes (``server.publisher.Publisher``): the calls a
-``MachineHandle`` takes, sent as frames over that process's ingest websocket and answered by it
-(docs/api.md, "Ingest"). The publishing process applies them to its machine and emits the control
-events in its own stream, so they reach this server, its log and the pages like its other events.
+"""Controls of a machine that another process publishes (``server.publisher.Publisher``): its
+``fsm.control.Controls``, each call sent as a frame over that process's ingest websocket and answered
+by it (docs/api.md, "Ingest"), or asked of its robot over Zenoh (server/cli/fleet_bridge.py's link).
+The publishing process applies them to its machine and emits the control events in its own stream,
+so they reach this server, its log and the pages like its other events.
 
 A call waits for the publisher's answer (at most ``ANSWER_TIMEOUT``): like a local control, it runs
 in a worker thread, never on the event loop.
@@ -13,11 +14,11 @@ import asyncio
 import concurrent.futures
 import itertools
 import time
-from typing import TYPE_CHECKING, Any, Awaitable, Callable
+from typing import TYPE_CHECKING, Any, Awaitable, Callable, Protocol
 
 from pydantic import ValidationError
 
-from fsm.control.handle import ControlError
+from fsm.control.controls import Capabilities, Refused
 from fsm.observation import schema
 from fsm.observation.encoding import dumps
 
@@ -29,8 +30,11 @@ if TYPE_CHECKING:
 ANSWER_TIMEOUT = 5.0  # seconds a control waits for the publishing process's answer (then 504)
 
 
-def not_connected(name: str) -> ControlError:
-    return ControlError(409, "the publishing process of %r is not connected: its controls are unavailable" % name)
+NOT_CONNECTED = "the publishing process of %r is not connected: its controls are unavailable"
+
+
+def not_connected(name: str) -> Refused:
+    return Refused(409, NOT_CONNECTED % name)
 
 
 class IngestLink:
@@ -56,7 +60,7 @@ class IngestLink:
 
     def feeds(self, entry: MachineEntry) -> None:
         """An event of ``entry``'s machine came through this connection."""
-        entry.connected = True
+        entry.origin.connected = True
         if entry.name not in self.fed:
             self.fed.add(entry.name)
             self._bind(entry)
@@ -88,21 +92,20 @@ class IngestLink:
         self.closed = True
         for name in self.fed:
             entry = self.hub.get(name)
-            if entry is None or entry.source != "ingest":
+            if entry is None or entry.origin.source != "ingest":
                 continue
-            entry.connected = False
-            if entry.remote is not None and entry.remote.link is self:
-                entry.remote.link = None
+            entry.origin.connected = False
+            controls = entry.controls
+            if isinstance(controls, RemoteHandle) and controls.link is self:
+                controls.link = None
         for name, future in list(self._pending.values()):
             if not future.done():
                 future.set_exception(not_connected(name))
 
     def _bind(self, entry: MachineEntry | None) -> None:
-        if entry is None or entry.source != "ingest" or entry.name not in self.controllable:
+        if entry is None or entry.origin.source != "ingest" or entry.name not in self.controllable:
             return
-        if entry.remote is None:
-            entry.remote = RemoteHandle(entry)
-        entry.remote.bind(self)
+        remote_controls(entry).bind(self)
 
     # From any thread.
     def post(self, frame: dict) -> None:
@@ -118,7 +121,7 @@ class IngestLink:
     # In a worker thread.
     def ask(self, machine: str, action: str, params: dict, client: str) -> dict:
         """Send a control and wait for its answer: the answer's frame when it took it (2xx), else
-        ControlError with the publisher's status and message (or 409/502/504 saying what failed)."""
+        Refused with the publisher's status and message (or 409/502/504 saying what failed)."""
         answer_id = next(self._ids)
         future: concurrent.futures.Future = concurrent.futures.Future()
         self._pending[answer_id] = (machine, future)
@@ -142,58 +145,73 @@ class IngestLink:
         return taken(machine, answer)
 
     @staticmethod
-    def _late(machine: str) -> ControlError:
-        return ControlError(504, "the publishing process of %r did not answer within %g s" % (machine, ANSWER_TIMEOUT))
+    def _late(machine: str) -> Refused:
+        return Refused(504, "the publishing process of %r did not answer within %g s" % (machine, ANSWER_TIMEOUT))
 
 
 def taken(machine: str, answer: dict) -> dict:
-    """``answer`` when it says the control was taken (2xx); else ControlError with the machine's status
+    """``answer`` when it says the control was taken (2xx); else Refused with the machine's status
     and message for a refusal (4xx), or 502 for an answer that says neither."""
     status = answer.get("status")
     if type(status) is int and 400 <= status < 500:
         detail = answer.get("detail")
-        raise ControlError(status, detail if type(detail) is str else "refused by the publishing process")
+        raise Refused(status, detail if type(detail) is str else "refused by the publishing process")
     if status not in (200, 202):
         raise malformed(machine, "status %r" % (status,))
     return answer
 
 
-def malformed(machine: str, what: str) -> ControlError:
-    return ControlError(502, "the publishing process of %r answered with a malformed %s" % (machine, what))
+def malformed(machine: str, what: str) -> Refused:
+    return Refused(502, "the publishing process of %r answered with a malformed %s" % (machine, what))
+
+
+def remote_controls(entry: MachineEntry) -> RemoteHandle:
+    """The entry's RemoteHandle, made its controls the first time its door binds a link."""
+    if not isinstance(entry.controls, RemoteHandle):
+        entry.controls = RemoteHandle(entry.name)
+    return entry.controls
+
+
+class Link(Protocol):
+    """How a RemoteHandle reaches the machine's process: an ``IngestLink``, or a fleet_bridge.FleetLink."""
+
+    @property
+    def closed(self) -> bool: ...
+
+    @property
+    def controllable(self) -> dict[str, bool]: ...
+
+    def ask(self, machine: str, action: str, params: dict, client: str) -> dict: ...
+
+    def post(self, frame: dict) -> None: ...
 
 
 class RemoteHandle:
-    """The controls of an ingested machine whose publisher takes them: the calls the routes make on a
-    MachineHandle and its DebugControl, each answered by the publishing process. Kept on the machine's
-    entry across reconnections (``link``: the connection now, None while its publisher is away)."""
+    """The ``Controls`` of an ingested machine whose publisher takes them, each answered by the
+    publishing process. Kept as the machine's entry's controls across reconnections (``link``: the
+    connection now, None while its publisher is away)."""
 
-    def __init__(self, entry: MachineEntry) -> None:
-        self.entry = entry
-        self.name = entry.name
-        self.link: IngestLink | None = None
+    held = False  # its publisher holds it: the page is not told (can_hold is false)
+
+    def __init__(self, name: str) -> None:
+        self.name = name
+        self.link: Link | None = None
         self._lease: dict | None = None  # the last lease frame: said again when the publisher comes back
 
-    def bind(self, link: IngestLink) -> None:
+    def bind(self, link: Link) -> None:
         self.link = link
         if self._lease is not None:
             link.post(self._lease)
 
-    @property
-    def connected(self) -> bool:
+    def capabilities(self) -> Capabilities:
         link = self.link
-        return link is not None and not link.closed
-
-    @property
-    def can_start(self) -> bool:
-        link = self.link
-        return link is not None and link.controllable.get(self.name, False)
-
-    def is_running(self) -> bool:
-        return self.entry.running()
-
-    def debug_control(self) -> RemoteHandle:
-        """The debug routes' calls are this handle's own: the publisher holds the debugger."""
-        return self
+        if link is None or link.closed:
+            return Capabilities(unavailable=NOT_CONNECTED % self.name)
+        cannot = {"hold": "the publishing process of %r does not say whether it runs the machine in a loop"
+                          % self.name}
+        if not link.controllable.get(self.name, False):
+            cannot["start"] = "the publishing process of %r cannot re-run the machine" % self.name
+        return Capabilities(cannot=cannot)
 
     def lease_changed(self, held: bool, after: float, action: str) -> None:
         """Tell the publisher (server/lease.py calls this): while a lease is held, it applies ``action``

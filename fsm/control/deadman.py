@@ -12,14 +12,14 @@ from __future__ import annotations
 import threading
 
 from .frames import apply_deadman, lease_of
-from .handle import MachineHandle
+from .controls import Controls
 
 
 class Deadmen:
     """The leases one dashboard holds on this process's machines (``handles``: by name), and the
     deadmen they arm; what they do is a ``control`` event by ``client``."""
 
-    def __init__(self, handles: dict[str, MachineHandle], client: str, link: str) -> None:
+    def __init__(self, handles: dict[str, Controls], client: str, link: str) -> None:
         self.handles = handles
         self.client = client
         self.link = link  # what was lost, as the deadman's reason says it

@@ -4,6 +4,7 @@
 The runtime says what happened (``debug`` events); this says who asked and whether it was
 taken (``control`` events), as every other control does. Like the other controls, the calls
 may block briefly on the debugger's lock, so the app runs them in a worker thread.
+``handle.MachineHandle`` composes it: this module knows only the machine and how to record.
 """
 
 from __future__ import annotations
@@ -12,20 +13,23 @@ from typing import Any, Callable
 
 from fsm.debugging import DebugError, debugger_of
 
-from .handle import ControlError, MachineHandle
+from .controls import Refused
 
 # The HTTP status of each kind of refusal: the request's content is wrong (422), or the machine
 # is not in a state to take it (409).
 STATUS = {"unknown-state": 422, "unknown-outcome": 422, "bad-breakpoint": 422, "not-active": 409,
           "not-paused": 409}
 
+# What records a control: (action, client, result, params=...) -> the control event's seq.
+Record = Callable[..., int]
+
 
 class DebugControl:
-    """Pause, resume, step, force and breakpoints of the machine behind ``handle``."""
+    """Pause, resume, step, force and breakpoints of ``machine``; ``record`` writes the control events."""
 
-    def __init__(self, handle: MachineHandle) -> None:
-        self.handle = handle
-        self.debugger = debugger_of(handle.machine)
+    def __init__(self, machine: Any, record: Record) -> None:
+        self.record = record
+        self.debugger = debugger_of(machine)
 
     def pause(self, client: str) -> int:
         return self._do("pause", client, {}, lambda: self.debugger.pause(by=client))
@@ -52,10 +56,10 @@ class DebugControl:
         return self.debugger.breakpoints()
 
     def _do(self, action: str, client: str, params: dict, call: Callable[[], None]) -> int:
-        """Run ``call``; the control event says it was accepted, or why not (then ControlError)."""
+        """Run ``call``; the control event says it was accepted, or why not (then Refused)."""
         try:
             call()
         except DebugError as err:
-            self.handle.emit_control(action, client, err.message, params=params)
-            raise ControlError(STATUS[err.problem], err.message) from None
-        return self.handle.emit_control(action, client, "accepted", params=params)
+            self.record(action, client, err.message, params=params)
+            raise Refused(STATUS[err.problem], err.message) from None
+        return self.record(action, client, "accepted", params=params)

@@ -1,6 +1,6 @@
 """The publishing process's side of remote control (server/remote_control.py is the server's): a
-control frame applied to a machine of this process through the same ``MachineHandle`` and
-``DebugControl`` a local machine's requests go through, and the deadman a publisher applies itself
+control frame applied to a machine of this process through the same ``Controls`` (its
+``MachineHandle``) a local machine's requests go through, and the deadman a publisher applies itself
 when its connection to the dashboard is gone while an operator holds the machine's lease. The
 websocket publisher (server/publisher.py) and the Zenoh robot (fleet/robot.py) both apply frames here.
 """
@@ -11,7 +11,7 @@ from typing import Any, Callable
 
 from fsm.observation import schema
 
-from .handle import ControlError, MachineHandle
+from .controls import Controls, Refused
 
 DEADMAN_ACTIONS = schema.DEADMAN_ACTIONS  # what a deadman does when its lease lapses
 MAX_AFTER = 86400.0  # a deadman's delay longer than a day is not one (and would overflow a timer's wait)
@@ -22,37 +22,37 @@ class Params:
 
     def __init__(self, params: Any) -> None:
         if type(params) is not dict:
-            raise ControlError(422, "params must be an object")
+            raise Refused(422, "params must be an object")
         self.params = params
 
     def text(self, key: str) -> str:
         value = self.params.get(key)
         if type(value) is not str:
-            raise ControlError(422, "params.%s must be a string" % key)
+            raise Refused(422, "params.%s must be a string" % key)
         return value
 
     def optional_text(self, key: str) -> str | None:
         value = self.params.get(key)
         if value is not None and type(value) is not str:
-            raise ControlError(422, "params.%s must be a string or null" % key)
+            raise Refused(422, "params.%s must be a string or null" % key)
         return value
 
     def texts(self, key: str) -> list[str]:
         value = self.params.get(key, [])
         if type(value) is not list or any(type(item) is not str for item in value):
-            raise ControlError(422, "params.%s must be a list of strings" % key)
+            raise Refused(422, "params.%s must be a list of strings" % key)
         return value
 
     def object(self, key: str) -> dict:
         value = self.params.get(key) or {}
         if type(value) is not dict:
-            raise ControlError(422, "params.%s must be an object" % key)
+            raise Refused(422, "params.%s must be an object" % key)
         return value
 
     def items(self, key: str) -> list:
         value = self.params.get(key, [])
         if type(value) is not list:
-            raise ControlError(422, "params.%s must be a list" % key)
+            raise Refused(422, "params.%s must be a list" % key)
         return value
 
 
@@ -61,7 +61,7 @@ def _seq(status: int, call: Callable[[], int]) -> dict:
 
 
 # What each action does, and the 2xx its answer has (docs/api.md: the statuses of the REST controls).
-CONTROLS: dict[str, Callable[[MachineHandle, Params, str], dict]] = {
+CONTROLS: dict[str, Callable[[Controls, Params, str], dict]] = {
     "preempt": lambda h, p, c: _seq(202, lambda: h.preempt(p.optional_text("reason"), c)),
     "hold": lambda h, p, c: _seq(202, lambda: h.hold(p.optional_text("reason"), c)),
     "initial-state": lambda h, p, c: _seq(200, lambda: h.set_initial_state(p.optional_text("path"), p.texts("states"),
@@ -70,17 +70,17 @@ CONTROLS: dict[str, Callable[[MachineHandle, Params, str], dict]] = {
     "record": lambda h, p, c: _seq(200, lambda: h.emit_control(p.text("action"), c, p.text("result"),
                                                                p.optional_text("reason"), p.object("params"),
                                                                p.optional_text("path"))),
-    "pause": lambda h, p, c: _seq(202, lambda: h.debug_control().pause(c)),
-    "resume": lambda h, p, c: _seq(202, lambda: h.debug_control().resume(c)),
-    "step": lambda h, p, c: _seq(202, lambda: h.debug_control().step(p.optional_text("level"), c)),
-    "force": lambda h, p, c: _seq(202, lambda: h.debug_control().force(p.text("state"), p.text("outcome"), c)),
+    "pause": lambda h, p, c: _seq(202, lambda: h.pause(c)),
+    "resume": lambda h, p, c: _seq(202, lambda: h.resume(c)),
+    "step": lambda h, p, c: _seq(202, lambda: h.step(p.optional_text("level"), c)),
+    "force": lambda h, p, c: _seq(202, lambda: h.force(p.text("state"), p.text("outcome"), c)),
     "breakpoints": lambda h, p, c: {"status": 200,
-                                    "breakpoints": h.debug_control().set_breakpoints(p.items("breakpoints"), c)},
-    "get-breakpoints": lambda h, p, c: {"status": 200, "breakpoints": h.debug_control().breakpoints()},
+                                    "breakpoints": h.set_breakpoints(p.items("breakpoints"), c)},
+    "get-breakpoints": lambda h, p, c: {"status": 200, "breakpoints": h.breakpoints()},
 }
 
 
-def answer(handles: dict[str, MachineHandle], frame: dict) -> tuple[str, dict] | None:
+def answer(handles: dict[str, Controls], frame: dict) -> tuple[str, dict] | None:
     """The answer to a control frame, with the machine it named (None: a frame with no id to answer).
     Never raises: what the request or the machine refused is the answer's 4xx and ``detail``."""
     answer_id = frame.get("id")
@@ -90,14 +90,14 @@ def answer(handles: dict[str, MachineHandle], frame: dict) -> tuple[str, dict] |
     handle = handles.get(machine) if type(machine) is str else None
     try:
         if handle is None:
-            raise ControlError(404, "no machine named %r publishes from this process" % (machine,))
+            raise Refused(404, "no machine named %r publishes from this process" % (machine,))
         if type(client) is not str:
-            raise ControlError(422, "client must be a string")
+            raise Refused(422, "client must be a string")
         control = CONTROLS.get(action) if type(action) is str else None
         if control is None:
-            raise ControlError(422, "unknown action %r (one of %s)" % (action, ", ".join(CONTROLS)))
+            raise Refused(422, "unknown action %r (one of %s)" % (action, ", ".join(CONTROLS)))
         fields = control(handle, Params(frame.get("params", {})), client)
-    except ControlError as err:
+    except Refused as err:
         fields = {"status": err.status, "detail": err.message}
     except Exception as exc:  # the machine's own code failed: say so, keep publishing
         fields = {"status": 409, "detail": "the publishing process failed: %s: %s" % (type(exc).__name__, exc)}
@@ -115,14 +115,14 @@ def lease_of(frame: dict) -> tuple[str, tuple[float, str] | None] | None:
     return machine, ((float(after), action) if held and action != "none" else None)
 
 
-def apply_deadman(handle: MachineHandle, action: str, client: str, reason: str, params: dict) -> None:
+def apply_deadman(handle: Controls, action: str, client: str, reason: str, params: dict) -> None:
     """A deadman's ``action`` (pause or preempt), recorded first as a ``control`` event of the machine
     (action "deadman"); a pause or preempt refused (not running) is said by its own control event."""
     handle.emit_control("deadman", client, "accepted", reason=reason, params=dict(params, then=action))
     try:
         if action == "pause":
-            handle.debug_control().pause(client)
+            handle.pause(client)
         elif action == "preempt":
             handle.preempt(reason, client)
-    except ControlError:
+    except Refused:
         pass

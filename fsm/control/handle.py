@@ -1,4 +1,5 @@
-"""Machine handles: what a control request can do to a machine of this process.
+"""A machine of this process's ``Controls`` (fsm/control/controls.py): preempt, hold, initial state,
+start, and its debugger's (``debug.DebugControl``).
 
 Every call here may block briefly on the machine's own locks, so the app runs them in a
 worker thread, never on the event loop.
@@ -8,30 +9,22 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import TYPE_CHECKING, Any, Callable
+from typing import Any, Callable
 
 from fsm.observation import introspection
 from fsm.observation import structure
 from fsm.observation.schema import build
 
-if TYPE_CHECKING:
-    from .debug import DebugControl
-
+from .controls import Capabilities, Refused
+from .debug import DebugControl
 
 LAST_RUN_GRACE = 1.0  # seconds a start waits for the previous run's execute() to return
-
-
-class ControlError(Exception):
-    """A request the machine cannot honour now; ``status`` is the HTTP status to answer."""
-
-    def __init__(self, status: int, message: str) -> None:
-        super().__init__(message)
-        self.status = status
-        self.message = message
+CANNOT_START = "this process cannot re-run the machine (can_start is false)"
+CANNOT_HOLD = "this machine is not run in a loop: there is no next run to hold"
 
 
 class MachineHandle:
-    """Preempt, set the initial state of, and re-run one local machine.
+    """Preempt, set the initial state of, re-run and debug one local machine (``Controls``).
 
     A re-run executes the machine in a new thread of this handle, unless a ``starter`` is given:
     then a start calls ``starter()`` instead (in the request's worker thread, never on the event
@@ -55,6 +48,15 @@ class MachineHandle:
         self._thread: threading.Thread | None = None
         self._pending: list[tuple[Any, list[str], dict | None]] = []
         self._hook_installed = False
+        self._debug: DebugControl | None = None
+
+    def capabilities(self) -> Capabilities:
+        cannot = {}
+        if not self.can_start:
+            cannot["start"] = CANNOT_START
+        if self.holder is None:
+            cannot["hold"] = CANNOT_HOLD
+        return Capabilities(cannot=cannot)
 
     def is_running(self) -> bool:
         running = getattr(self.machine, "is_running", None)
@@ -73,11 +75,30 @@ class MachineHandle:
         """Nothing to tell: the server applies the deadman itself to a machine of its own process
         (a remote machine's handle tells its publisher, server/remote_control.py)."""
 
-    def debug_control(self) -> DebugControl:
-        """Its debugger's controls: what the debug routes call on every kind of handle."""
-        from .debug import DebugControl  # that module builds on this one
+    # The debugger (attached on the first of these calls: a machine nobody debugs never pays for one).
+    @property
+    def debug(self) -> DebugControl:
+        if self._debug is None:
+            self._debug = DebugControl(self.machine, self.emit_control)
+        return self._debug
 
-        return DebugControl(self)
+    def pause(self, client: str) -> int:
+        return self.debug.pause(client)
+
+    def resume(self, client: str) -> int:
+        return self.debug.resume(client)
+
+    def step(self, level: str | None, client: str) -> int:
+        return self.debug.step(level, client)
+
+    def force(self, state: str, outcome: str, client: str) -> int:
+        return self.debug.force(state, outcome, client)
+
+    def set_breakpoints(self, breakpoints: list[Any], client: str) -> list[dict]:
+        return self.debug.set_breakpoints(breakpoints, client)
+
+    def breakpoints(self) -> list[dict]:
+        return self.debug.breakpoints()
 
     # Preempt (the /sm_stop of this world).
     def preempt(self, reason: str | None, client: str) -> int:
@@ -85,7 +106,7 @@ class MachineHandle:
             if self.holder is not None:  # between two runs of a loop: the next one must not start
                 return self._hold("preempt", reason, client)
             self.emit_control("preempt", client, "not running", reason)
-            raise ControlError(409, "machine is not running")
+            raise Refused(409, "machine is not running")
         seq = self.emit_control("preempt", client, "accepted", reason)
         self.machine.request_preempt()
         return seq
@@ -94,7 +115,7 @@ class MachineHandle:
         """Let the current run finish, then start no other until the next start."""
         if self.holder is None:
             self.emit_control("hold", client, "no loop to hold", reason)
-            raise ControlError(409, "this machine is not run in a loop: there is no next run to hold")
+            raise Refused(409, CANNOT_HOLD)
         return self._hold("hold", reason, client)
 
     def _hold(self, action: str, reason: str | None, client: str) -> int:
@@ -117,11 +138,11 @@ class MachineHandle:
         try:
             container = self.container_at(path)
             if container is None:
-                raise ControlError(404, "no state at path %r" % path)
+                raise Refused(404, "no state at path %r" % path)
             if not structure.is_container(container):
-                raise ControlError(422, "%r is a state, not a container" % path)
+                raise Refused(422, "%r is a state, not a container" % path)
             self._check_states(container, states)
-        except ControlError as err:
+        except Refused as err:
             self.emit_control("initial-state", client, err.message, params=params, path=path)
             raise
         with self._lock:
@@ -140,13 +161,13 @@ class MachineHandle:
         children = container.get_children()
         unknown = [s for s in states if s not in children]
         if unknown:
-            raise ControlError(422, "unknown states %s in %s (states: %s)" % (unknown, kind, sorted(children)))
+            raise Refused(422, "unknown states %s in %s (states: %s)" % (unknown, kind, sorted(children)))
         if not states:
             return
         if structure.is_concurrence(container):
-            raise ControlError(422, "a Concurrence starts all its children; it takes no initial states")
+            raise Refused(422, "a Concurrence starts all its children; it takes no initial states")
         if len(states) > 1:
-            raise ControlError(422, "a %s has exactly one initial state" % kind)
+            raise Refused(422, "a %s has exactly one initial state" % kind)
 
     @staticmethod
     def _apply(container: Any, states: list[str], userdata: dict | None) -> None:
@@ -171,13 +192,13 @@ class MachineHandle:
         with self._lock:
             if not self.can_start:
                 self.emit_control("start", client, "this process cannot re-run the machine")
-                raise ControlError(409, "this process cannot re-run the machine (can_start is false)")
+                raise Refused(409, CANNOT_START)
             # The last run's outcome is out (a page can ask for the next run at once) a moment before
             # its execute() has returned, in our thread or the process's own: give it that long.
             self._wait_until_stopped(LAST_RUN_GRACE)
             if self.is_running():
                 self.emit_control("start", client, "already running")
-                raise ControlError(409, "machine is running")
+                raise Refused(409, "machine is running")
             pending, self._pending = self._pending, []
             for target, states, userdata in pending:
                 self._apply(target, states, userdata)
@@ -189,7 +210,7 @@ class MachineHandle:
                 except Exception as exc:
                     message = "the starter failed: %s: %s" % (type(exc).__name__, exc)
                     self.emit_control("start", client, message)
-                    raise ControlError(409, message) from exc
+                    raise Refused(409, message) from exc
                 return seq
             thread = threading.Thread(target=self._run, name="fsmscope-run-%s" % self.reporter.machine, daemon=True)
             self._thread = thread

@@ -17,9 +17,9 @@ import sys
 import threading
 from typing import TYPE_CHECKING, Callable
 
-from fsm.control.handle import ControlError
+from fsm.control.controls import Refused
 
-from ..remote_control import RemoteHandle, not_connected, taken
+from ..remote_control import RemoteHandle, not_connected, remote_controls, taken
 from .serving import SWITCH_INTERVAL, CannotServe
 
 if TYPE_CHECKING:
@@ -108,9 +108,10 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
 
 def robot_follows(robot: ZenohRobot, entry: MachineEntry) -> None:
     """A machine this process's dashboard serves too: the robot publishes the events the hub encodes
-    anyway (rather than observing the machine itself), applies the dashboards' controls through the
-    hub's handle, and answers state queries from the hub's Status."""
-    entry.tap = robot.follow(entry.name, entry.handle, entry.lock, lambda: entry.status)
+    anyway (a sink of its feed, rather than observing the machine itself), applies the dashboards'
+    controls through the hub's handle, and answers state queries from the hub's Status."""
+    feed = entry.feed
+    feed.add_encoded_sink(robot.follow(entry.name, entry.local.handle, feed.lock, lambda: feed.status))
 
 
 class FleetLink:
@@ -140,7 +141,7 @@ class FleetLink:
         answer = self.watcher.ask(self.robot, self.machine, self.token, action, params, client)
         if answer is None:
             # Zenoh ends a query its access control denies as if nobody were there: say both.
-            raise ControlError(504, "robot %r did not answer the control of %r: it is unreachable, or its Zenoh "
+            raise Refused(504, "robot %r did not answer the control of %r: it is unreachable, or its Zenoh "
                                     "access control denies this dashboard's controls" % (self.robot, self.machine))
         return taken(machine, answer)
 
@@ -213,9 +214,9 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
         entry = hub.get(events[0]["machine"])
         if entry is None:
             return
-        entry.connected = alive.get(entry.name, True)
-        entry.robot = entry.name.partition(":")[0]
-        if entry.remote is None:
+        entry.origin.connected = alive.get(entry.name, True)
+        entry.origin.robot = entry.name.partition(":")[0]
+        if not isinstance(entry.controls, RemoteHandle):
             bind(entry)
 
     def bind(entry: MachineEntry) -> None:
@@ -223,16 +224,16 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
         robot = entry.name.partition(":")[0]
         token = tokens.get(robot, tokens.get(None))
         if token is not None and watcher.controls.get(entry.name):
-            entry.remote = RemoteHandle(entry)
-            entry.remote.bind(FleetLink(watcher, entry.name, token, alive))
+            remote_controls(entry).bind(FleetLink(watcher, entry.name, token, alive))
 
     def seen(name: str, up: bool) -> None:
         alive[name] = up
         entry = hub.get(name)
         if entry is not None:
-            entry.connected = up
-            if up and entry.remote is not None and entry.remote.link is not None:
-                entry.remote.bind(entry.remote.link)  # the lease said again: its process may be a new one
+            entry.origin.connected = up
+            controls = entry.controls
+            if up and isinstance(controls, RemoteHandle) and controls.link is not None:
+                controls.bind(controls.link)  # the lease said again: its process may be a new one
 
     try:
         watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),

@@ -42,9 +42,9 @@ async def _pump(hub: Hub, live: FoxgloveLive) -> None:
     while True:
         for entry in hub.machines():
             last = fed.get(entry.name)
-            lines = entry.encoded_from(last + 1, BATCH) if last is not None else None
+            lines = entry.feed.encoded_from(last + 1, BATCH) if last is not None else None
             if lines is None:
-                seq, frame = entry.snapshot()
+                seq, frame = entry.feed.snapshot()
                 status = loads(frame)["status"]
                 live.event({"kind": "snapshot", "machine": entry.name, "seq": seq, "t": status.get("last_t") or 0.0,
                             "run": status.get("run"), "path": status.get("root_path") or "", "status": status})

@@ -140,15 +140,15 @@ def load(hub: Hub, reader: Reader, speed: float) -> int:
     returns the number of events."""
     from fsm.logfiles.log_reader import read_events
 
-    from ..history import History
+    from ..log_history import LogHistory
 
     count = 0
     for event in read_events(reader.path, reader=reader):
         hub.ingest(event, "replay")
         count += 1
     for entry in hub.machines():
-        entry.replay = {"speed": speed}
-        entry.history = History.from_log(reader.path, entry.name)
+        entry.origin.replay = {"speed": speed}
+        entry.read_past_from(LogHistory(reader.path, entry.name))
     return count
 
 
@@ -189,7 +189,7 @@ def replay_in_browser(args: argparse.Namespace) -> int:
 
 def pose_scene(hub: Hub) -> Any:
     """A 3D view that draws the recorded arm (no simulation runs) when the log recorded its pose, else None."""
-    pose = next((entry.status.pose for entry in hub.machines() if entry.status.pose is not None), None)
+    pose = next((entry.feed.status.pose for entry in hub.machines() if entry.feed.status.pose is not None), None)
     if pose is None:
         return None
     from sim.scene import start_pose_scene

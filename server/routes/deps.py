@@ -8,7 +8,7 @@ from typing import Annotated
 from fastapi import Depends, HTTPException, Path, Request, WebSocket
 from starlette.requests import HTTPConnection
 
-from fsm.control.handle import MachineHandle
+from fsm.control.controls import Controls, Refused
 
 from .. import models
 from ..auth import require_operator, require_token, websocket_refusal
@@ -16,7 +16,6 @@ from ..hub import Hub, MachineEntry
 from ..lease import LeaseHeld
 from ..lease_control import LeaseControl
 from ..middleware import deny_handshake
-from ..remote_control import RemoteHandle, not_connected
 
 ERRORS = {code: {"model": models.Error} for code in (400, 401, 403, 404, 409, 413, 422)}
 NAME = Path(min_length=1, max_length=200, description="machine name")
@@ -42,21 +41,17 @@ def get_machine(name: Annotated[str, NAME], hub: HubDep) -> MachineEntry:
 Machine = Annotated[MachineEntry, Depends(get_machine)]
 
 
-def get_handle(entry: Machine) -> MachineHandle | RemoteHandle:
-    """The control handle of the machine the path names: its own in this process, or its publisher's
-    (remote_control.py); 409 when nothing takes its controls now."""
-    if entry.handle is not None:
-        return entry.handle
-    if entry.source == "replay":
-        raise HTTPException(409, "machine %r is a recording being replayed: nothing to control" % entry.name)
-    if entry.remote is None:
-        raise HTTPException(409, "machine %r runs in another process: control it there" % entry.name)
-    if not entry.remote.connected:
-        raise not_connected(entry.name)
-    return entry.remote
+def get_controls(entry: Machine) -> Controls:
+    """The controls of the machine the path names (fsm/control/controls.py), whatever kind of machine it
+    is; 409 saying why when nothing takes them now."""
+    controls = entry.controls
+    unavailable = controls.capabilities().unavailable
+    if unavailable is not None:
+        raise Refused(409, unavailable)
+    return controls
 
 
-Handle = Annotated[MachineHandle | RemoteHandle, Depends(get_handle)]
+MachineControls = Annotated[Controls, Depends(get_controls)]
 
 
 PAGE_HEADER = "x-fsmscope-page"  # the page a request comes from (static/api.js PAGE_ID): who holds a lease
@@ -93,7 +88,8 @@ def get_leases(connection: HTTPConnection) -> LeaseControl:
 Leases = Annotated[LeaseControl, Depends(get_leases)]
 
 
-def require_lease(entry: Machine, handle: Handle, page: Page, client: ClientAddress, leases: Leases) -> None:
+def require_lease(entry: Machine, controls: MachineControls, page: Page, client: ClientAddress,
+                  leases: Leases) -> None:
     """Dependency of a control that needs the operator lease (server/lease.py): 409 saying who holds it
     when another page does; a page's first control takes a free one."""
     try:

@@ -19,7 +19,7 @@ from fsm.observation import structure
 from fsm.observation.schema import KINDS, MAX_PATH
 
 from .. import models
-from ..history import DEFAULT_LIMIT, MAX_LIMIT, HistoryError, HistoryView
+from ..history import DEFAULT_LIMIT, MAX_LIMIT, HistoryView
 from .deps import AUTH, ERRORS, HubDep, Machine
 
 router = APIRouter(dependencies=AUTH, tags=["machines"])
@@ -34,14 +34,11 @@ T_EXAMPLES = {"an instant": {"value": 1700000000.5, "description": "the status a
 
 
 async def answer(hub: HubDep, entry: Machine, question: Callable[[HistoryView], Any]) -> Any:
-    """``question(view)`` on a view of the machine's history, in the thread pool; its HistoryError
-    as the HTTP error it names."""
+    """``question(view)`` on a view of the machine's history, in the thread pool (what it refuses is
+    answered as any ``Refused`` is, by the app)."""
     hub.fanout.flush()
-    view = entry.history.view()
-    try:
-        return await run_in_threadpool(question, view)
-    except HistoryError as exc:
-        raise HTTPException(exc.status, exc.message) from None
+    view = entry.past.view()
+    return await run_in_threadpool(question, view)
 
 
 @router.get("/api/machines/{name}/status", response_model=models.MachineStatus, responses=PAST_ERRORS)
@@ -57,7 +54,7 @@ async def status(hub: HubDep, entry: Machine,
     if t is not None and not math.isfinite(t):
         raise HTTPException(422, "t must be a finite number of seconds, not %s" % t)
     if seq is None and t is None:
-        data = entry.status_dict()
+        data = entry.feed.status_dict()
     else:
         data = await answer(hub, entry, lambda view: view.status_at(seq, t))
     return Response(dumps(data), media_type="application/json")
@@ -94,7 +91,7 @@ async def summary(hub: HubDep, entry: Machine,
                                                        "container (default: every state visited)")] = None,
                   ) -> Response:
     """Per-state statistics (visits, time in state, last outcome), as ``fsmscope replay`` counts them."""
-    root = entry.status.structure
+    root = entry.feed.status.structure
     if path is not None and structure.node_at(root, path) is None:
         raise HTTPException(404, "machine %r has no state %r" % (entry.name, path[:200]))
     data = await answer(hub, entry, lambda view: entry.stats.answer(view, root, path))

@@ -9,23 +9,23 @@ from typing import Annotated
 from fastapi import APIRouter, Body, HTTPException
 from fastapi.concurrency import run_in_threadpool
 
-from .. import models
+from ..control_models import Deadman, LeaseHolder, LeaseRequest, LeaseState
 from ..lease import BEAT_EVERY, Lease, LeaseHeld, short
-from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Handle, Leases, Machine, Page
+from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Leases, Machine, MachineControls, Page
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["lease"])
 
 
-def _state(leases: Leases, name: str, page: str | None) -> models.LeaseState:
+def _state(leases: Leases, name: str, page: str | None) -> LeaseState:
     lease = leases.leases.holder(name)
     deadman = leases.leases.deadman
-    return models.LeaseState(
+    return LeaseState(
         holder=_holder(lease), yours=lease is not None and lease.page == page,
-        deadman=models.Deadman(after=deadman.after, action=deadman.action), beat_every=BEAT_EVERY)
+        deadman=Deadman(after=deadman.after, action=deadman.action), beat_every=BEAT_EVERY)
 
 
-def _holder(lease: Lease | None) -> models.LeaseHolder | None:
-    return None if lease is None else models.LeaseHolder(page=short(lease.page), client=lease.client,
+def _holder(lease: Lease | None) -> LeaseHolder | None:
+    return None if lease is None else LeaseHolder(page=short(lease.page), client=lease.client,
                                                          since=lease.since)
 
 
@@ -35,16 +35,16 @@ def _needs_page(page: str | None) -> str:
     return page
 
 
-@router.get("/api/machines/{name}/lease", response_model=models.LeaseState)
-async def lease(entry: Machine, leases: Leases, page: Page) -> models.LeaseState:
+@router.get("/api/machines/{name}/lease", response_model=LeaseState)
+async def lease(entry: Machine, leases: Leases, page: Page) -> LeaseState:
     return _state(leases, entry.name, page)
 
 
-@router.post("/api/machines/{name}/lease", response_model=models.LeaseState, dependencies=OPERATOR,
+@router.post("/api/machines/{name}/lease", response_model=LeaseState, dependencies=OPERATOR,
              description="Take control of the machine (409 saying who holds it, unless `takeover`: then "
                          "the other page loses it, and the event says so).")
-async def take(entry: Machine, handle: Handle, leases: Leases, page: Page, client: ClientAddress,
-               body: Annotated[models.LeaseRequest | None, Body()] = None) -> models.LeaseState:
+async def take(entry: Machine, controls: MachineControls, leases: Leases, page: Page, client: ClientAddress,
+               body: Annotated[LeaseRequest | None, Body()] = None) -> LeaseState:
     page = _needs_page(page)
     takeover = body.takeover if body is not None else False
     try:
@@ -54,10 +54,10 @@ async def take(entry: Machine, handle: Handle, leases: Leases, page: Page, clien
     return _state(leases, entry.name, page)
 
 
-@router.post("/api/machines/{name}/lease/beat", response_model=models.LeaseState, dependencies=OPERATOR,
+@router.post("/api/machines/{name}/lease/beat", response_model=LeaseState, dependencies=OPERATOR,
              description="The holder page's heartbeat (409 when it no longer holds the lease: it lapsed, or "
                          "another page took it over).")
-async def beat(entry: Machine, leases: Leases, page: Page) -> models.LeaseState:
+async def beat(entry: Machine, leases: Leases, page: Page) -> LeaseState:
     page = _needs_page(page)
     try:
         leases.beat(entry, page)
@@ -66,10 +66,10 @@ async def beat(entry: Machine, leases: Leases, page: Page) -> models.LeaseState:
     return _state(leases, entry.name, page)
 
 
-@router.delete("/api/machines/{name}/lease", response_model=models.LeaseState, dependencies=OPERATOR,
+@router.delete("/api/machines/{name}/lease", response_model=LeaseState, dependencies=OPERATOR,
                description="Give control up (nothing happens to the machine).")
-async def release(entry: Machine, handle: Handle, leases: Leases, page: Page, client: ClientAddress
-                  ) -> models.LeaseState:
+async def release(entry: Machine, controls: MachineControls, leases: Leases, page: Page, client: ClientAddress
+                  ) -> LeaseState:
     page = _needs_page(page)
     if not await run_in_threadpool(leases.release, entry, page, client):
         raise HTTPException(409, "this page does not control machine %r" % entry.name)

@@ -20,31 +20,30 @@ router = APIRouter(dependencies=AUTH, tags=["machines"])
 async def list_machines(hub: HubDep) -> list[dict]:
     out = []
     for entry in hub.machines():
-        status = entry.status
-        handle = entry.handle
-        remote = entry.remote if entry.remote is not None and entry.remote.connected else None
-        can_start = handle.can_start if handle is not None else remote is not None and remote.can_start
+        status = entry.feed.status
+        controls, origin = entry.controls, entry.origin
+        capabilities = controls.capabilities()
         out.append({"name": entry.name, "running": entry.running(), "outcome": status.outcome,
-                    "last_seq": status.last_seq, "root_path": status.root_path, "can_start": bool(can_start),
-                    "controllable": handle is not None or remote is not None,
-                    "can_hold": bool(handle is not None and handle.holder is not None),
-                    "held": bool(handle is not None and handle.held),
-                    "source": entry.source, "connected": entry.connected, "rejected": entry.rejected,
-                    "replay": entry.replay})
+                    "last_seq": status.last_seq, "root_path": status.root_path,
+                    "can_start": capabilities.can("start"), "controllable": capabilities.unavailable is None,
+                    "can_hold": capabilities.can("hold"), "held": bool(controls.held),
+                    "source": origin.source, "connected": origin.connected, "rejected": origin.rejected,
+                    "replay": origin.replay})
     return out
 
 
 @router.get("/api/machines/{name}/structure", response_model=models.StructureNode, responses=ERRORS)
 async def structure(entry: Machine) -> Any:
-    if entry.status.structure is None:
+    root = entry.feed.status.structure
+    if root is None:
         raise HTTPException(404, "machine %r has no structure yet" % entry.name)
-    return entry.status.structure
+    return root
 
 
 @router.get("/api/machines/{name}/graph.svg",
             responses={**ERRORS, 200: {"content": {"image/svg+xml": {}}, "description": "the graph"}})
 async def graph_svg(entry: Machine, expand: Annotated[list[str] | None, Query(max_length=200)] = None) -> Response:
-    root = entry.status.structure
+    root = entry.feed.status.structure
     if root is None:
         raise HTTPException(404, "machine %r has no structure yet" % entry.name)
     key, n_states = entry.structure_info()

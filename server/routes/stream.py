@@ -69,7 +69,7 @@ async def stream(websocket: WebSocket, name: str, hub: HubDep) -> None:
         await server_send({"type": "websocket.send", "text": frame})
 
     fanout = hub.fanout
-    client = fanout.subscribe(entry, since, _abort(server_send))
+    client = fanout.subscribe(entry.feed, since, _abort(server_send))
     sender = asyncio.ensure_future(fanout.run_client(client, send))
     client.task = sender
     receiver = asyncio.ensure_future(_receive(websocket, client))

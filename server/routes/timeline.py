@@ -34,7 +34,7 @@ async def timeline(entry: Machine, hub: HubDep,
     if since_t is not None and until_t is not None and since_t > until_t:
         raise HTTPException(422, "since_t (%r) is after until_t (%r)" % (since_t, until_t))
     hub.fanout.flush()
-    answer = await run_in_threadpool(_answer, entry.timeline, entry.history.view(), since_t, until_t, buckets)
+    answer = await run_in_threadpool(_answer, entry.timeline, entry.past.view(), since_t, until_t, buckets)
     return Response(dumps(answer), media_type="application/json")
 
 

@@ -8,7 +8,7 @@ import threading
 import fsm
 import pytest
 from browser_support import watch
-from server.fanout import HISTORY
+from server.feed import HISTORY
 from server.http_server import ServerThread
 from server.testing.polling import wait_for
 
@@ -52,7 +52,7 @@ def served():
     runner.start()
     machines["ended"].execute()
     machines["long"].execute()
-    wait_for(lambda: srv.hub.get("started").status_dict()["containers"]["/SM_ROOT"]["active"] == ["WAIT"])
+    wait_for(lambda: srv.hub.get("started").feed.status_dict()["containers"]["/SM_ROOT"]["active"] == ["WAIT"])
     yield srv
     hold.set()
     runner.join(10)

@@ -296,7 +296,7 @@ def test_back_to_live_shows_the_machine_as_it_is_now(live_page):
 
 def paces(page) -> list:
     """The pace (s) each of the server's stream clients of the live machine asked for."""
-    return sorted(client.pace for client in page.server.hub.get("ticker").clients)
+    return sorted(client.pace for client in page.server.hub.get("ticker").feed.clients)
 
 
 def test_a_page_looking_back_asks_for_the_live_events_four_times_a_second_only(live_page):

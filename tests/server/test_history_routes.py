@@ -6,8 +6,8 @@ import pytest
 from fsm.logfiles.log_reader import read_events, seek
 from fsm.logfiles.recorder import Recorder
 
-from server import fanout
-from server.history import History
+from server import feed, history
+from server.history import LogHistory
 from server.testing.polling import wait_for
 from server_support import client
 from smach_support import counting_machine
@@ -141,21 +141,21 @@ def test_history_needs_the_token(live_server):
 
 
 def test_a_long_run_keeps_memory_bounded_and_seeks_its_beginning_in_the_recording(live_server, tmp_path, quiet):
-    rounds = 3 * fanout.RING_SIZE // 7  # about 3 rings of events
+    rounds = 3 * feed.RING_SIZE // 7  # about 3 rings of events
     path = run_recorded(live_server, tmp_path, rounds)
     http = client(live_server)
     status = http.get("/api/machines/m/status", params={"seq": 5})
     entry = live_server.hub.get("m")
     assert status.status_code == 200 and past(status.json()) == past(seek(path, "m", 5).status.to_dict())
-    assert entry.status.last_seq > 2 * fanout.RING_SIZE
-    assert len(entry.ring) == fanout.RING_SIZE
-    assert len(entry.keyframes) <= fanout.RING_SIZE // fanout.KEYFRAME_EVERY + 2
-    assert entry.keyframes[0][0] >= entry.ring[0][0] - 2 * fanout.KEYFRAME_EVERY
+    assert entry.feed.status.last_seq > 2 * feed.RING_SIZE
+    assert len(entry.feed.ring) == feed.RING_SIZE
+    assert len(entry.past.keyframes.kept) <= feed.RING_SIZE // history.KEYFRAME_EVERY + 2
+    assert entry.past.keyframes.kept[0][0] >= entry.feed.ring[0][0] - 2 * history.KEYFRAME_EVERY
     assert http.get("/api/machines/m/history", params={"limit": 3}).json()["first_seq"] == 1
 
 
 def test_without_a_recording_history_reaches_back_as_far_as_the_ring(live_server, tmp_path, quiet):
-    run_recorded(live_server, tmp_path, 2 * fanout.RING_SIZE // 7, recording=False)
+    run_recorded(live_server, tmp_path, 2 * feed.RING_SIZE // 7, recording=False)
     http = client(live_server)
     page = http.get("/api/machines/m/history", params={"limit": 1}).json()
     first = page["first_seq"]
@@ -179,7 +179,7 @@ def test_a_machine_served_from_a_log_alone_answers_from_it(live_server, tmp_path
     live_server.hub.loop.call_soon_threadsafe(live_server.hub.ingest, dict(first, machine="replayed"), "replay")
     wait_for(lambda: live_server.hub.get("replayed") is not None)
     http = client(live_server)
-    live_server.hub.get("replayed").history = History.from_log(path, "recorded")
+    live_server.hub.get("replayed").read_past_from(LogHistory(path, "recorded"))
     status = http.get("/api/machines/replayed/status", params={"seq": 300}).json()
     assert past(status) == past(seek(path, "recorded", 300).status.to_dict())
     assert http.get("/api/machines/replayed/history", params={"since": 300, "limit": 2}).json()["next"] == 302
@@ -209,7 +209,7 @@ def test_a_machine_of_another_process_answers_its_recent_past_from_memory(live_s
 
 
 def test_without_a_recording_the_timeline_says_how_far_back_an_instant_can_be_shown(live_server, tmp_path, quiet):
-    run_recorded(live_server, tmp_path, 2 * fanout.RING_SIZE // 7, recording=False)
+    run_recorded(live_server, tmp_path, 2 * feed.RING_SIZE // 7, recording=False)
     http = client(live_server)
     first = http.get("/api/machines/m/history", params={"limit": 1}).json()["first_seq"]
     timeline = http.get("/api/machines/m/timeline").json()

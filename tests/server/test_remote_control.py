@@ -97,7 +97,7 @@ def test_a_control_while_the_publisher_is_disconnected_is_409_saying_so(publishe
 def held_lease(pub: Published, after: float) -> None:
     """The operator's lease of the machine is held (as server/lease.py says it), and the publisher
     has it: a control sent after the lease frame is answered after the publisher read it."""
-    pub.srv.hub.get("remote").remote.lease_changed(True, after, "pause")
+    pub.srv.hub.get("remote").controls.lease_changed(True, after, "pause")
     assert pub.http.get("/api/machines/remote/breakpoints").status_code == 200
 
 
@@ -194,7 +194,7 @@ def test_a_start_waits_for_a_run_of_another_thread_to_return():
     own = threading.Thread(target=sm.execute)
     own.start()
     wait_for(lambda: runs, 5)
-    handle.start("me")  # raised ControlError(409, "machine is running") before it waited
+    handle.start("me")  # raised Refused(409, "machine is running") before it waited
     own.join(5)
     handle.join(5)
     assert len(runs) == 2

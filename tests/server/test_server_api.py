@@ -211,9 +211,9 @@ def test_control_requests_become_control_events(live_server):
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     client(live_server).post("/api/machines/two/preempt", json={"reason": "why not"})
-    wait_for(lambda: any(seq for seq, _ in entry.ring))
+    wait_for(lambda: any(seq for seq, _ in entry.feed.ring))
     import json
-    [event] = [json.loads(enc) for _, enc in entry.ring]
+    [event] = [json.loads(enc) for _, enc in entry.feed.ring]
     assert (event["kind"], event["action"], event["reason"], event["result"], event["client"]) == \
         ("control", "preempt", "why not", "not running", "127.0.0.1 (operator)")
 
@@ -246,7 +246,7 @@ def test_start_with_a_starter_calls_it_in_a_worker_thread_instead_of_running_the
     answer = client(live_server).post("/api/machines/hosted/start", json={})
     assert answer.status_code == 202
     assert len(calls) == 1 and calls[0] not in (live_server._thread.ident, threading.get_ident())
-    assert entry.handle._thread is None and entry.reporter.run is None  # the hub did not execute it
+    assert entry.local.handle._thread is None and entry.local.reporter.run is None  # the hub did not execute it
 
 
 def test_a_failing_starter_answers_409_with_its_message(live_server):

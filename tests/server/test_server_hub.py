@@ -8,7 +8,7 @@ import fsm
 from fsm.observation.status import Status
 
 from recording_support import two_state_loop
-from server import fanout
+from server import fanout, feed
 from server.testing.clients import stalled_stream
 from server.testing.polling import wait_for
 from server_support import blob_loop, events_of, frames, stream, two_state_machine
@@ -20,13 +20,13 @@ def has_terminate(got):
 
 def test_each_event_is_encoded_once_for_all_clients(live_server, monkeypatch):
     encoded = []
-    real = fanout.encoded
+    real = feed.encoded
 
     def counting(event):
         encoded.append(event["seq"])
         return real(event)
 
-    monkeypatch.setattr(fanout, "encoded", counting)
+    monkeypatch.setattr(feed, "encoded", counting)
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     sockets = [stream(live_server, "two") for _ in range(3)]
@@ -36,7 +36,7 @@ def test_each_event_is_encoded_once_for_all_clients(live_server, monkeypatch):
     for ws in sockets:
         frames(ws, has_terminate)
         ws.close()
-    assert sorted(encoded) == list(range(1, entry.reporter.last_seq + 1))
+    assert sorted(encoded) == list(range(1, entry.local.reporter.last_seq + 1))
 
 
 class CountingEvent(asyncio.Event):
@@ -55,8 +55,8 @@ def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
     entry = live_server.hub.add_local(sm, name="loop")
     raw = stalled_stream(live_server, "loop")
     try:
-        wait_for(lambda: len(entry.clients) == 1)
-        [client] = list(entry.clients)
+        wait_for(lambda: len(entry.feed.clients) == 1)
+        [client] = list(entry.feed.clients)
 
         # Fill the socket buffers until a send blocks: one that started and is still not done 0.2 s
         # later (a send that merely happened to be under way would finish and wake the client again).
@@ -71,9 +71,9 @@ def test_a_stalled_client_is_not_touched_per_event(live_server, monkeypatch):
         counting = client.wake = CountingEvent()
         for _ in range(5):
             sm.execute()  # 5 x 3,000 more events
-        wait_for(lambda: entry.loop_seq == entry.reporter.last_seq)
+        wait_for(lambda: entry.feed.loop_seq == entry.local.reporter.last_seq)
         assert client.send_started is not None and counting.sets == 0
-        assert client not in entry.idle
+        assert client not in entry.feed.idle
     finally:
         raw.close()
 
@@ -93,17 +93,17 @@ def test_a_blocked_loop_bounds_the_handoff_and_clients_end_with_the_true_status(
         longest = [0]
 
         def watch(event):
-            longest[0] = max(longest[0], len(entry.handoff))
+            longest[0] = max(longest[0], len(entry.feed.handoff))
         fsm.attach(sm, watch)
         try:
             assert sm.execute() == "done"
-            assert entry.reporter.last_seq > 200_000
-            assert longest[0] <= fanout.HANDOFF_LIMIT  # memory bounded while nobody drains
-            assert entry.status_dict()["outcome"] == "done"  # the hub's Status did not wait for the loop
+            assert entry.local.reporter.last_seq > 200_000
+            assert longest[0] <= feed.HANDOFF_LIMIT  # memory bounded while nobody drains
+            assert entry.feed.status_dict()["outcome"] == "done"  # the hub's Status did not wait for the loop
         finally:
             release.set()
         got = frames(ws, lambda got: got and got[-1]["type"] == "snapshot" and
-                     got[-1]["last_seq"] == entry.reporter.last_seq, timeout=10)
+                     got[-1]["last_seq"] == entry.local.reporter.last_seq, timeout=10)
     assert got[-2]["type"] == "missed" and got[-2]["count"] > 0
     expected = truth.to_dict()
     assert got[-1]["status"] == expected

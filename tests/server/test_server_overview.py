@@ -60,8 +60,8 @@ def test_a_run_that_failed_stays_failed_when_its_process_goes(live_server):
         ev(3, "error", machine="r2:pick", state="A", exc_type="RuntimeError", message="jammed"),
         ev(4, "terminate", machine="r2:pick", last=["A"], state_outcome=None, outcome=None, active=[],
            error="RuntimeError: jammed")])
-    live_server.hub.get("r2:pick").connected = False
-    live_server.hub.get("r2:pick").robot = "r2"
+    live_server.hub.get("r2:pick").origin.connected = False
+    live_server.hub.get("r2:pick").origin.robot = "r2"
     tile = tiles(live_server)["r2:pick"]
     assert (tile["state"], tile["error"], tile["connected"], tile["robot"], tile["machine"]) == (
         "failed", "RuntimeError", False, "r2", "pick")
@@ -70,7 +70,7 @@ def test_a_run_that_failed_stays_failed_when_its_process_goes(live_server):
 def test_a_running_machine_whose_process_goes_is_gone(live_server):
     ingest(live_server, "r3:patrol", started("r3:patrol"))
     assert tiles(live_server)["r3:patrol"]["state"] == "running"
-    live_server.hub.get("r3:patrol").connected = False
+    live_server.hub.get("r3:patrol").origin.connected = False
     assert tiles(live_server)["r3:patrol"]["state"] == "gone"
 
 

@@ -50,9 +50,9 @@ def test_since_beyond_what_is_kept_gets_a_snapshot(live_server, monkeypatch):
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     sm.execute()
-    wait_for(lambda: len(entry.ring) > 3)
+    wait_for(lambda: len(entry.feed.ring) > 3)
     for _ in range(3):
-        entry.ring.popleft()  # as if the ring had wrapped
+        entry.feed.ring.popleft()  # as if the ring had wrapped
     with stream(live_server, "two", since=1) as ws:
         [snap] = frames(ws, lambda got: len(got) == 1)
     assert snap["type"] == "snapshot" and snap["status"]["outcome"] == "done"
@@ -101,10 +101,10 @@ def test_a_client_that_falls_behind_gets_missed_then_a_snapshot(live_server, mon
     entry = live_server.hub.add_local(sm, name="two")
     with stream(live_server, "two") as ws:
         frames(ws, lambda got: len(got) == 1)
-        [client] = list(entry.clients)
+        [client] = list(entry.feed.clients)
         client.wake.set = lambda: None  # the sender sleeps through the run: its queue overflows
         sm.execute()
-        wait_for(lambda: entry.loop_seq == entry.reporter.last_seq)
+        wait_for(lambda: entry.feed.loop_seq == entry.local.reporter.last_seq)
         asyncio_set(live_server, client)
         got = frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
     assert got[0]["type"] == "missed" and got[0]["count"] > 5
@@ -118,10 +118,10 @@ def test_every_frame_the_stream_sends_fits_its_definition_in_the_schema(live_ser
     sm.execute()  # a run already: a new page's snapshot carries its history
     with stream(live_server, "two") as ws:
         got = frames(ws, lambda got: len(got) == 1)
-        [client] = list(entry.clients)
+        [client] = list(entry.feed.clients)
         client.wake.set = lambda: None  # the sender sleeps through the run: its queue overflows
         sm.execute()
-        wait_for(lambda: entry.loop_seq == entry.reporter.last_seq)
+        wait_for(lambda: entry.feed.loop_seq == entry.local.reporter.last_seq)
         asyncio_set(live_server, client)
         got += frames(ws, lambda got: any(f["type"] == "snapshot" for f in got))
         monkeypatch.setattr(fanout, "CLIENT_QUEUE", 4000)
@@ -142,11 +142,11 @@ def test_a_stalled_client_is_dropped_and_the_machine_does_not_wait(live_server, 
     sm = blob_loop(20000)
     entry = live_server.hub.add_local(sm, name="loop")
     raw = stalled_stream(live_server, "loop")  # never read again
-    wait_for(lambda: len(entry.clients) == 1)
+    wait_for(lambda: len(entry.feed.clients) == 1)
     started = time.monotonic()
     assert sm.execute() == "done"
     assert time.monotonic() - started < 5
-    wait_for(lambda: not entry.clients, timeout=5)
+    wait_for(lambda: not entry.feed.clients, timeout=5)
     raw.close()
 
 
@@ -187,10 +187,10 @@ def test_publisher_keeps_the_machine_running_without_a_server_and_reconnects():
     assert wait.entered.wait(5)  # the machine runs while the server is gone
     srv2 = ServerThread(port=port, token=token).start()
     try:
-        wait_for(lambda: srv2.hub.get("away") is not None and srv2.hub.get("away").status.running, timeout=10)
+        wait_for(lambda: srv2.hub.get("away") is not None and srv2.hub.get("away").feed.status.running, timeout=10)
         wait.release.set()
         thread.join(5)
-        wait_for(lambda: srv2.hub.get("away").status.outcome == "done", timeout=5)
+        wait_for(lambda: srv2.hub.get("away").feed.status.outcome == "done", timeout=5)
     finally:
         wait.release.set()
         pub.close(1)
@@ -227,7 +227,7 @@ def test_a_paced_client_gets_every_event_in_at_most_one_frame_per_pace(live_serv
     with stream(live_server, "loop") as ws:
         frames(ws, lambda got: len(got) == 1)
         ws.send(json.dumps({"type": "pace", "ms": 400}))
-        wait_for(lambda: [c.pace for c in entry.clients] == [0.4])
+        wait_for(lambda: [c.pace for c in entry.feed.clients] == [0.4])
         started = time.monotonic()
         loop_in_background(sm)
         got = frames(ws, lambda got: any(e["kind"] == "terminate" and e["path"] == "/SM_ROOT"
@@ -247,7 +247,7 @@ def test_a_pace_of_zero_ends_a_wait_for_the_old_pace_at_once(live_server):
         with stream(live_server, "loop") as ws:
             frames(ws, lambda got: len(got) == 1)
             ws.send(json.dumps({"type": "pace", "ms": 10000}))
-            wait_for(lambda: [c.pace for c in entry.clients] == [10.0])
+            wait_for(lambda: [c.pace for c in entry.feed.clients] == [10.0])
             runner = loop_in_background(sm)
             with pytest.raises(TimeoutError):  # the snapshot went just now: the next frame waits 10 s
                 ws.recv(timeout=0.5)

@@ -13,7 +13,8 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from recording_support import record
 from server import history as history_module
-from server.history import History, HistoryError, LogHistory
+from fsm.control.controls import Refused
+from server.history import History, LogHistory
 from smach_support import counting_machine
 
 ROUNDS = 300
@@ -104,7 +105,7 @@ def test_seq_at_a_time_is_the_last_event_at_or_before_it(recorded):
 
 def test_a_time_before_the_first_event_is_gone(recorded):
     path, seen = recorded
-    with pytest.raises(HistoryError) as caught:
+    with pytest.raises(Refused) as caught:
         History.from_log(path, "m").status_at(t=seen[0]["t"] - 1)
     assert caught.value.status == 410 and "reaches back to seq 1" in caught.value.message
 
@@ -112,7 +113,7 @@ def test_a_time_before_the_first_event_is_gone(recorded):
 def test_status_beyond_the_last_event_is_416(recorded):
     path, seen = recorded
     last = seen[-1]["seq"]
-    with pytest.raises(HistoryError) as caught:
+    with pytest.raises(Refused) as caught:
         History.from_log(path, "m").status_at(last + 1)
     assert (caught.value.status, caught.value.message) == (416, "seq %d is beyond the last event (%d)"
                                                            % (last + 1, last))
@@ -165,7 +166,7 @@ def test_a_range_entirely_before_the_log_is_gone_and_one_that_overlaps_it_starts
     with open(clipped, "wb") as handle:
         handle.writelines(later)
     history = History.from_log(clipped, "m")
-    with pytest.raises(HistoryError) as caught:
+    with pytest.raises(Refused) as caught:
         history.page(since=0, until=2)
     assert caught.value.status == 410 and caught.value.message == "history reaches back to seq 3"
     assert seqs_of(history.page(since=0, limit=2)) == [3, 4]

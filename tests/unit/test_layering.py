@@ -117,3 +117,73 @@ def test_the_check_sees_a_wrong_arrow_inside_a_function(tmp_path, monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "ROOT", fake_root)
     assert wrong_arrows_of_fsm(module) == ["fsm/core/bad.py:2 imports fsm.logfiles",
                                            "fsm/core/bad.py:3 imports fastapi"]
+
+
+def import_graph(package: str) -> dict[str, set[str]]:
+    """Which of ``package``'s modules each of its modules imports (an ``__init__`` is its package's module)."""
+    modules = {}
+    for path in python_files(package):
+        parts = list(path.relative_to(ROOT).with_suffix("").parts)
+        if parts[-1] == "__init__":
+            parts.pop()
+        modules[".".join(parts)] = path
+    graph = {}
+    for name, path in modules.items():
+        targets = set()
+        for _, module in imported_modules(path):
+            while module and module not in modules:  # "from .routes import control" names a module or a name in one
+                module = module.rpartition(".")[0]
+            if module and module != name and not name.startswith(module + "."):  # a module's own package is no arrow
+                targets.add(module)
+        graph[name] = targets
+    return graph
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The import cycles of ``graph``: each strongly connected group of two or more modules, sorted (Tarjan's)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found = []
+
+    def visit(node: str) -> None:
+        index[node] = low[node] = len(index)
+        stack.append(node)
+        on_stack.add(node)
+        for target in sorted(graph.get(node, ())):
+            if target not in index:
+                visit(target)
+                low[node] = min(low[node], low[target])
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+        if low[node] == index[node]:
+            group = []
+            while True:
+                member = stack.pop()
+                on_stack.discard(member)
+                group.append(member)
+                if member == node:
+                    break
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for node in sorted(graph):
+        if node not in index:
+            visit(node)
+    return sorted(found)
+
+
+@pytest.mark.parametrize("package", ["fsm", "server", "fleet", "interop", "sim"])
+def test_no_import_cycle_among_a_packages_modules(package):
+    assert cycles(import_graph(package)) == []
+
+
+def test_the_cycle_check_sees_a_cycle_through_a_function_and_type_checking(tmp_path, monkeypatch):
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "a.py").write_text("def later():\n    from . import b\n")
+    (tmp_path / "pkg" / "b.py").write_text("from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from .c import C\n")
+    (tmp_path / "pkg" / "c.py").write_text("from pkg.a import later\n")
+    (tmp_path / "pkg" / "d.py").write_text("from . import a\n")
+    monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
+    assert cycles(import_graph("pkg")) == [["pkg.a", "pkg.b", "pkg.c"]]

@@ -10,7 +10,7 @@ import pytest
 from pydantic import BaseModel
 
 from fsm.observation import schema
-from server import models
+from server import control_models, models
 
 NONE = type(None)
 
@@ -82,4 +82,4 @@ def test_a_rest_model_allows_null_where_the_schema_does_and_holds_the_same_kind_
 
 def test_the_models_vocabularies_are_the_schemas():
     assert typing.get_args(models.MachineInfo.model_fields["source"].annotation) == schema.SOURCES
-    assert typing.get_args(models.Deadman.model_fields["action"].annotation) == schema.DEADMAN_ACTIONS
+    assert typing.get_args(control_models.Deadman.model_fields["action"].annotation) == schema.DEADMAN_ACTIONS

@@ -1,18 +1,17 @@
 """The fleet's key space on Zenoh: ``fsmscope/<robot>/<machine>/...``. Robot and machine names are
-single key chunks: characters Zenoh gives a meaning to (``/ * $ ? #``) are refused."""
+single key chunks: they keep the one name rule (fsm/observation/names.py), which refuses the
+characters Zenoh gives a meaning to (``/ * $ ? #``)."""
 
 from __future__ import annotations
 
+from fsm.observation import names
+
 PREFIX = "fsmscope"
-_RESERVED = set("/*$?#")
 
 
 def chunk(name: str, what: str) -> str:
     """``name`` as one chunk of a key; ValueError when it cannot be one."""
-    if not name or _RESERVED & set(name) or name != name.strip():
-        raise ValueError("a %s's name must be a non-empty key chunk without / * $ ? # or outer spaces: %r"
-                         % (what, name))
-    return name
+    return names.check(name, what)
 
 
 def machine_key(robot: str, machine: str) -> str:

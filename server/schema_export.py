@@ -11,7 +11,7 @@ import json
 import os
 import re
 
-from fsm.observation import schema
+from fsm.observation import names, schema
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JS_PATH = os.path.join(ROOT, "static", "schema.js")
@@ -63,12 +63,23 @@ export function containerKind(node) {
   if (CONTAINER_TYPES.includes(type)) return type;
   return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
 }
+
+// A machine's name (fsm/observation/names.py): 1 to MAX_NAME characters, none of / * $ ? # or a
+// control character, no space at either end; valid wherever a name travels.
+export const MAX_NAME = %(max_name)d;
+const NAME_FORBIDDEN = /[%(name_forbidden)s]/;
+
+export function isMachineName(name) {
+  return typeof name === "string" && name.length > 0 && [...name].length <= MAX_NAME && !name.startsWith(" ")
+    && !name.endsWith(" ") && !NAME_FORBIDDEN.test(name);
+}
 """ % {"version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
        "sources": json.dumps({s: s for s in schema.SOURCES}),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
        "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),
-       "kind_fields": json.dumps([list(pair) for pair in schema.KIND_FIELDS])}
+       "kind_fields": json.dumps([list(pair) for pair in schema.KIND_FIELDS]),
+       "max_name": names.MAX_NAME, "name_forbidden": "".join("\\u%04x" % ord(c) for c in names.FORBIDDEN)}
 
 
 def _table(fields: tuple[schema.Field, ...]) -> str:

@@ -60,7 +60,7 @@ def test_run_names_a_second_machine_after_the_script_with_a_number(tmp_path):
     log = tmp_path / "twice.jsonl"
     assert cli("run", script, "--record", log).returncode == 0
     summary = json.loads(cli("replay", log, "--json").stdout)
-    assert list(summary["machines"]) == ["twice", "twice#2"]
+    assert list(summary["machines"]) == ["twice", "twice-2"]
 
 
 def test_run_accepts_no_serve_and_exit(tmp_path):

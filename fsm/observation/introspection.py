@@ -17,6 +17,7 @@ from time import time as _now
 from typing import Any, Callable
 
 from ..core import log
+from . import names
 from .encoding import encode_userdata
 from .schema import MAX_DOC, event as _event
 from .structure import children, is_container
@@ -47,6 +48,7 @@ class Reporter:
         self._lock = threading.Lock()
         self._owner: int | None = None  # the thread delivering an event right now
         self._described_at = -1  # the construction generation of the last structure event
+        self._told: list[Observer] = []  # the observers whose failure was printed
 
     @property
     def last_seq(self) -> int:
@@ -87,11 +89,20 @@ class Reporter:
                 try:
                     observer(event)
                 except Exception:
-                    sys.stderr.write("fsm: an observer failed:\n" + traceback.format_exc())
+                    self._failed(observer)
         finally:
             self._owner = None
             lock.release()
         return event
+
+    def _failed(self, observer: Observer) -> None:
+        """An observer could not take an event: said once per observer (with why), not per event,
+        since one that fails once usually fails on every event that follows."""
+        if any(o is observer for o in self._told):
+            return
+        self._told.append(observer)
+        sys.stderr.write("fsm: an observer of machine %r failed (its next failures are not printed):\n%s"
+                         % (self.machine, traceback.format_exc()))
 
     def begin_run(self) -> None:
         """Called by the root container as it starts: a new run id, then the structure if it
@@ -155,10 +166,13 @@ def structure_changed() -> None:
 
 def attach(machine: Any, observer: Observer | None = None, name: str | None = None,
            path: str = DEFAULT_ROOT_PATH) -> Reporter:
-    """Observe a top-level container; a second call adds an observer to the same reporter."""
+    """Observe a top-level container; a second call adds an observer to the same reporter. ``name``
+    must keep the name rule (fsm/observation/names.py: ValueError saying why); without one the
+    machine is named after its root path."""
     rep = getattr(machine, "_reporter", None)
     if rep is None or rep.root is not machine:
-        rep = Reporter(machine, name or path.rsplit("/", 1)[-1] or "SM_ROOT", path)
+        name = names.check(name) if name else names.valid(path.rsplit("/", 1)[-1] or "SM_ROOT")
+        rep = Reporter(machine, name, path)
         machine._reporter = rep
         machine._path = path
         rep.structure()

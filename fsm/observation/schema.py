@@ -23,9 +23,10 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from .names import MAX_NAME, is_valid as _is_name
+
 VERSION = 1
 MAX_SEQ = 2 ** 53 - 1          # the browser's largest exact integer
-MAX_NAME = 200                 # a machine's name
 MAX_PATH = 4096                # a container or state path
 MAX_STRUCTURE_DEPTH = 64       # container levels; JSON encoders refuse much deeper nesting
 MAX_STRUCTURE_NODES = 200_000
@@ -104,7 +105,8 @@ STR = _simple("a string", (str,))
 BOOL = _simple("a boolean", (bool,))
 NUMBER = _simple("a finite number", (float, int), lambda v: type(v) is int or math.isfinite(v))
 SEQ = _simple("an integer from 0 to 2^53-1", (int,), lambda v: 0 <= v <= MAX_SEQ)
-NAME = _simple("a string of 1 to %d characters" % MAX_NAME, (str,), lambda v: 0 < len(v) <= MAX_NAME)
+NAME = _simple("a name of 1 to %d characters (no / * $ ? #, control character or outer space)" % MAX_NAME,
+               (str,), _is_name)
 PATH = _simple("a string of 1 to %d characters" % MAX_PATH, (str,), lambda v: 0 < len(v) <= MAX_PATH)
 OPT_STR = _nullable(STR)
 OPT_NUMBER = _nullable(NUMBER)

@@ -13,6 +13,10 @@ A subcommand module has::
     def arguments(parser) -> None: ...  # its options
     def main(args) -> int: ...          # the exit code; import fastapi, uvicorn, sim in here, not at module level
 
+and, when some of its options mean nothing together, ``def unused(args, given) -> str | None``:
+what is wrong with the options ``given`` (the set of those given a value other than their
+default), said as the command's usage error (exit code 2) rather than silently ignored.
+
 To add one, write the module and list it in ``SUBCOMMANDS``.
 """
 
@@ -48,6 +52,18 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _refuse_unused(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """The command's usage error (exit 2) when options were given that mean nothing together."""
+    unused = getattr(SUBCOMMANDS[args.command], "unused", None)
+    if unused is None:
+        return
+    sub = parser._subparsers._group_actions[0].choices[args.command]  # argparse keeps no other handle on it
+    given = {dest for dest, value in vars(args).items() if value != sub.get_default(dest)}
+    problem = unused(args, given)
+    if problem:
+        sub.error(problem)
+
+
 def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
     """For a subcommand that passes arguments on (to a script): its own arguments, and those after
     the first '--', as they are. argparse cannot be left to it: it keeps that '--' among the
@@ -64,6 +80,7 @@ def main(argv: list[str] | None = None) -> int:
     args, extra = parser.parse_known_args(own)
     if extra and not SUBCOMMANDS[args.command].PASSES_ARGUMENTS_ON:
         parser.error("unrecognized arguments: %s" % " ".join(extra))
+    _refuse_unused(parser, args)
     args.extra = extra + passed_on
     try:
         return SUBCOMMANDS[args.command].main(args)

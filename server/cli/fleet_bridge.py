@@ -70,6 +70,7 @@ def zenoh_config_file(path: str) -> str:
 
 
 TOKEN_ENV = "FSMSCOPE_ZENOH_TOKEN"
+ZENOH_OPTIONS = ("zenoh_connect", "zenoh_listen", "zenoh_token", "zenoh_mode", "zenoh_scouting", "zenoh_config")
 
 
 def zenoh_tokens(args: argparse.Namespace) -> dict[str | None, str]:

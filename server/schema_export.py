@@ -11,7 +11,7 @@ import json
 import os
 import re
 
-from fsm.observation import names, schema
+from fsm.observation import names, schema, vocabularies
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JS_PATH = os.path.join(ROOT, "static", "schema.js")
@@ -73,13 +73,32 @@ export function isMachineName(name) {
   return typeof name === "string" && name.length > 0 && [...name].length <= MAX_NAME && !name.startsWith(" ")
     && !name.endsWith(" ") && !NAME_FORBIDDEN.test(name);
 }
+
+// The words the server and the page share (fsm/observation/vocabularies.py).
+
+/** A machine's run states. */
+export const RUN_STATES = Object.freeze(%(run_states)s);
+
+/** The run state of a machine: `running`, `outcome` and `error` from its status, `connected` from its
+ * /api/machines entry (false: its process left). Mirrors vocabularies.run_state. */
+export function runState(running, outcome, error, connected) {
+  if (running) return connected === false ? RUN_STATES.gone : RUN_STATES.running;
+  if (outcome !== null && outcome !== undefined) return RUN_STATES.done;
+  if (error !== null && error !== undefined) return RUN_STATES.failed;
+  return connected === false ? RUN_STATES.gone : RUN_STATES.idle;
+}
+
+/** The kinds of the timeline's ticks: an event of one of these kinds, or a run's start (the last). */
+export const TICK_KINDS = Object.freeze(%(tick_kinds)s);
 """ % {"version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
        "sources": json.dumps({s: s for s in schema.SOURCES}),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
        "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),
        "kind_fields": json.dumps([list(pair) for pair in schema.KIND_FIELDS]),
-       "max_name": names.MAX_NAME, "name_forbidden": "".join("\\u%04x" % ord(c) for c in names.FORBIDDEN)}
+       "max_name": names.MAX_NAME, "name_forbidden": "".join("\\u%04x" % ord(c) for c in names.FORBIDDEN),
+       "run_states": json.dumps({state: state for state in vocabularies.RUN_STATES}),
+       "tick_kinds": json.dumps(list(vocabularies.TICK_KINDS))}
 
 
 def _table(fields: tuple[schema.Field, ...]) -> str:

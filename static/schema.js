@@ -48,3 +48,20 @@ export function isMachineName(name) {
   return typeof name === "string" && name.length > 0 && [...name].length <= MAX_NAME && !name.startsWith(" ")
     && !name.endsWith(" ") && !NAME_FORBIDDEN.test(name);
 }
+
+// The words the server and the page share (fsm/observation/vocabularies.py).
+
+/** A machine's run states. */
+export const RUN_STATES = Object.freeze({"running": "running", "done": "done", "failed": "failed", "idle": "idle", "gone": "gone"});
+
+/** The run state of a machine: `running`, `outcome` and `error` from its status, `connected` from its
+ * /api/machines entry (false: its process left). Mirrors vocabularies.run_state. */
+export function runState(running, outcome, error, connected) {
+  if (running) return connected === false ? RUN_STATES.gone : RUN_STATES.running;
+  if (outcome !== null && outcome !== undefined) return RUN_STATES.done;
+  if (error !== null && error !== undefined) return RUN_STATES.failed;
+  return connected === false ? RUN_STATES.gone : RUN_STATES.idle;
+}
+
+/** The kinds of the timeline's ticks: an event of one of these kinds, or a run's start (the last). */
+export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug", "run"]);

@@ -43,25 +43,27 @@ SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": repl
                                       "import": bag_import, "demo": demo, "router": router}
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The command line's parser, and each subcommand's."""
     parser = argparse.ArgumentParser(prog="fsmscope", description="Run, watch, record and replay SMACH-style state machines.")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     commands.required = True
+    parsers = {}
     for name, sub in SUBCOMMANDS.items():
-        sub.arguments(commands.add_parser(name, help=sub.HELP, description=sub.HELP))
-    return parser
+        parsers[name] = commands.add_parser(name, help=sub.HELP, description=sub.HELP)
+        sub.arguments(parsers[name])
+    return parser, parsers
 
 
 def _refuse_unused(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
-    """The command's usage error (exit 2) when options were given that mean nothing together."""
+    """``parser``'s usage error (exit 2) when options of its command were given that mean nothing together."""
     unused = getattr(SUBCOMMANDS[args.command], "unused", None)
     if unused is None:
         return
-    sub = parser._subparsers._group_actions[0].choices[args.command]  # argparse keeps no other handle on it
-    given = {dest for dest, value in vars(args).items() if value != sub.get_default(dest)}
+    given = {dest for dest, value in vars(args).items() if value != parser.get_default(dest)}
     problem = unused(args, given)
     if problem:
-        sub.error(problem)
+        parser.error(problem)
 
 
 def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
@@ -75,12 +77,12 @@ def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    parser, parsers = build_parser()
     own, passed_on = _split_passed_on(sys.argv[1:] if argv is None else list(argv))
     args, extra = parser.parse_known_args(own)
     if extra and not SUBCOMMANDS[args.command].PASSES_ARGUMENTS_ON:
         parser.error("unrecognized arguments: %s" % " ".join(extra))
-    _refuse_unused(parser, args)
+    _refuse_unused(parsers[args.command], args)
     args.extra = extra + passed_on
     try:
         return SUBCOMMANDS[args.command].main(args)

@@ -14,6 +14,15 @@ def chunk(name: str, what: str) -> str:
     return names.check(name, what)
 
 
+def robot_chunk(name: str) -> str:
+    """A robot's name as a key chunk, without ``:`` too: a dashboard names the robot's machines
+    ``<robot>:<machine>`` (fleet/watcher.py ``fleet_name``) and reads the robot back up to the first one."""
+    if ":" in chunk(name, "robot"):
+        raise ValueError("a robot's name must not hold ':' (a dashboard names its machines <robot>:<machine>): %r"
+                         % name)
+    return name
+
+
 def machine_key(robot: str, machine: str) -> str:
     """The machine's own key: its liveliness token (alive while its process is)."""
     return "%s/%s/%s" % (PREFIX, chunk(robot, "robot"), chunk(machine, "machine"))

@@ -71,3 +71,10 @@ def test_the_page_takes_the_same_names_as_python():
     done = subprocess.run(["node", "--input-type=module", "-e", program], capture_output=True, text=True, timeout=30)
     assert done.returncode == 0, done.stderr
     assert json.loads(done.stdout) == [names.is_valid(n) for n in NAMES]
+
+
+def test_a_robot_named_with_the_fleets_separator_is_refused_before_it_joins():
+    from fleet.robot import ZenohRobot
+
+    with pytest.raises(ValueError, match="a robot's name must not hold ':'"):
+        ZenohRobot("lab:1")

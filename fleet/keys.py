@@ -1,17 +1,25 @@
 """The fleet's key space on Zenoh: ``fsmscope/<robot>/<machine>/...``. Robot and machine names are
-single key chunks: characters Zenoh gives a meaning to (``/ * $ ? #``) are refused."""
+single key chunks: they keep the one name rule (fsm/observation/names.py), which refuses the
+characters Zenoh gives a meaning to (``/ * $ ? #``)."""
 
 from __future__ import annotations
 
+from fsm.observation import names
+
 PREFIX = "fsmscope"
-_RESERVED = set("/*$?#")
 
 
 def chunk(name: str, what: str) -> str:
     """``name`` as one chunk of a key; ValueError when it cannot be one."""
-    if not name or _RESERVED & set(name) or name != name.strip():
-        raise ValueError("a %s's name must be a non-empty key chunk without / * $ ? # or outer spaces: %r"
-                         % (what, name))
+    return names.check(name, what)
+
+
+def robot_chunk(name: str) -> str:
+    """A robot's name as a key chunk, without ``:`` too: a dashboard names the robot's machines
+    ``<robot>:<machine>`` (fleet/watcher.py ``fleet_name``) and reads the robot back up to the first one."""
+    if ":" in chunk(name, "robot"):
+        raise ValueError("a robot's name must not hold ':' (a dashboard names its machines <robot>:<machine>): %r"
+                         % name)
     return name
 
 

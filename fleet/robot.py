@@ -172,7 +172,7 @@ class ZenohRobot:
     def __init__(self, robot: str, connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
                  scouting: bool = False, token: str | None = None, can_start: bool = False,
                  config_file: str | None = None) -> None:
-        self.robot = keys.chunk(robot, "robot")
+        self.robot = keys.robot_chunk(robot)
         self.can_start = can_start
         self.session = open_session(connect, listen, mode, scouting, config_file)
         self.controls = RobotControls(token, self.flush)

@@ -26,7 +26,7 @@ from __future__ import annotations
 import heapq
 from typing import Any, Callable, Iterable, Iterator
 
-from fsm.observation import schema
+from fsm.observation import names, schema
 from fsm.observation.schema import build
 from fsm.observation.encoding import dumps, encode_userdata
 
@@ -224,16 +224,19 @@ class _Machine:
 
 def events(messages: Iterable[Message]) -> Iterator[dict]:
     """fsmscope's events of every introspection server in ``messages`` (time order), one machine per
-    server named after it; each machine's events in order, the machines' interleaved by time."""
+    server named after it (a ROS name made a machine's name: ``robot/arm`` becomes ``robot_arm``,
+    fsm/observation/names.py); each machine's events in order, the machines' interleaved by time."""
     by_server: dict[str, list[Message]] = {}
     for m in messages:
         by_server.setdefault(m.server, []).append(m)
     streams = []
+    taken: set[str] = set()
     for server, msgs in by_server.items():
         tree = _Tree(msgs)
         if tree.root is None:
             continue
-        machine = _Machine(server, tree)
+        machine = _Machine(names.unique(server, taken), tree)
+        taken.add(machine.name)
         streams.append(_machine_events(machine, msgs))
     yield from _merge(streams)
 

@@ -20,7 +20,7 @@ from typing import Any, Callable
 
 from fsm.control.controls import Controls, NoControls
 from fsm.control.handle import MachineHandle
-from fsm.observation import introspection, schema
+from fsm.observation import introspection, names, schema
 from fsm.observation import structure
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
@@ -128,13 +128,9 @@ class Hub:
         return self._machines.get(name)
 
     def unique_name(self, name: str) -> str:
+        """A valid name made of ``name`` that no machine of the hub has (fsm/observation/names.py)."""
         with self._lock:
-            if name not in self._machines:
-                return name
-            i = 2
-            while "%s-%d" % (name, i) in self._machines:
-                i += 1
-            return "%s-%d" % (name, i)
+            return names.unique(name, self._machines)
 
     def add_local(self, machine: Any, name: str | None = None, path: str = introspection.DEFAULT_ROOT_PATH,
                   can_start: bool = True, starter: Callable[[], Any] | None = None,

@@ -15,26 +15,19 @@ import collections
 import time
 from typing import TYPE_CHECKING
 
+from fsm.observation.vocabularies import run_state
+
 if TYPE_CHECKING:
     from .hub import Hub, MachineEntry
 
 RATE_WINDOW = 5.0  # seconds of samples the event rate is the mean over
-STATES = ("running", "failed", "done", "idle", "gone")
 
 
 def state_of(entry: MachineEntry) -> str:
-    """The tile's state: failed (its run ended on an error, without an outcome), done (reached an
-    outcome), running, idle (not started yet), or gone: its process went away while it ran or idled,
-    so nobody can tell what it does now. A run that ended stays failed or done when its process goes
-    (the tile's ``connected`` says it is gone too)."""
+    """The tile's run state (fsm/observation/vocabularies.py); a run that ended stays failed or done
+    when its process goes (the tile's ``connected`` says it is gone too)."""
     status = entry.feed.status
-    if status.outcome is not None and not status.running:
-        return "done"
-    if status.error is not None and not status.running:
-        return "failed"
-    if entry.origin.gone:
-        return "gone"
-    return "running" if entry.running() else "idle"
+    return run_state(entry.running(), status.outcome, status.error, entry.origin.connected)
 
 
 class Overview:

@@ -2,7 +2,7 @@
 
 The script does not know: a global introspection hook attaches a Recorder to each
 top-level machine the first time it starts, naming it after the script (``foo_bar``,
-then ``foo_bar#2`` for a second machine). Whoever serves a dashboard registers
+then ``foo_bar-2`` for a second machine: fsm/observation/names.py). Whoever serves a dashboard registers
 ``on_machine`` callbacks to attach its own observers to the same machines (they run in
 the machine's thread, before its first event).
 
@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import fsm
+from fsm.observation import names
 from fsm.observation.introspection import reporter_of
 from fsm.logfiles.recorder import Recorder
 
@@ -64,10 +65,11 @@ class Runner:
         with self._lock:
             if any(m.container is container for m in self.machines):
                 return
-            name = self.stem if not self.machines else "%s#%d" % (self.stem, len(self.machines) + 1)
             rep = reporter_of(container)
             if rep is not None:  # the script attached it itself: keep the name it chose
                 name = rep.machine
+            else:
+                name = names.unique(self.stem, {m.name for m in self.machines})
             machine = Machine(name, container)
             self.machines.append(machine)
         fsm.attach(container, self.recorder, name=name)

@@ -12,7 +12,7 @@ import json
 import os
 import re
 
-from fsm.observation import schema
+from fsm.observation import names, schema, vocabularies
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JS_PATH = os.path.join(ROOT, "static", "schema.js")
@@ -96,6 +96,33 @@ export function containerKind(node) {
   return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
 }
 
+// A machine's name (fsm/observation/names.py): 1 to MAX_NAME characters, none of / * $ ? # or a
+// control character, no space at either end; valid wherever a name travels.
+export const MAX_NAME = %(max_name)d;
+const NAME_FORBIDDEN = /[%(name_forbidden)s]/;
+
+export function isMachineName(name) {
+  return typeof name === "string" && name.length > 0 && [...name].length <= MAX_NAME && !name.startsWith(" ")
+    && !name.endsWith(" ") && !NAME_FORBIDDEN.test(name);
+}
+
+// The words the server and the page share (fsm/observation/vocabularies.py).
+
+/** A machine's run states. */
+export const RUN_STATES = Object.freeze(%(run_states)s);
+
+/** The run state of a machine: `running`, `outcome` and `error` from its status, `connected` from its
+ * /api/machines entry (false: its process left). Mirrors vocabularies.run_state. */
+export function runState(running, outcome, error, connected) {
+  if (running) return connected === false ? RUN_STATES.gone : RUN_STATES.running;
+  if (outcome !== null && outcome !== undefined) return RUN_STATES.done;
+  if (error !== null && error !== undefined) return RUN_STATES.failed;
+  return connected === false ? RUN_STATES.gone : RUN_STATES.idle;
+}
+
+/** The kinds of the timeline's ticks: an event of one of these kinds, or a run's start (the last). */
+export const TICK_KINDS = Object.freeze(%(tick_kinds)s);
+
 // The shapes: every event, every websocket frame, a machine's status and what it holds
 // (import one with /** @typedef {import("./schema.js").NAME} NAME */).
 
@@ -104,7 +131,10 @@ export function containerKind(node) {
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
        "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),
-       "kind_fields": json.dumps([list(pair) for pair in schema.KIND_FIELDS])}
+       "kind_fields": json.dumps([list(pair) for pair in schema.KIND_FIELDS]),
+       "max_name": names.MAX_NAME, "name_forbidden": "".join("\\u%04x" % ord(c) for c in names.FORBIDDEN),
+       "run_states": json.dumps({state: state for state in vocabularies.RUN_STATES}),
+       "tick_kinds": json.dumps(list(vocabularies.TICK_KINDS))}
 
 
 def _table(fields: tuple[schema.Field, ...]) -> str:

@@ -19,6 +19,7 @@ from array import array
 from bisect import bisect_left, bisect_right
 
 from fsm.logfiles.transcript import debug_message
+from fsm.observation.vocabularies import EVENT_TICK_KINDS, RUN_TICK
 
 MAX_MARKS = 1_000_000     # transitions kept in full detail (per machine) before the older half is coalesced
 COARSE_BUCKETS = 10_000   # buckets the coalesced part keeps
@@ -29,7 +30,7 @@ SEVERAL = "+"             # a Concurrence with several children running
 MANY = "…"                # several states within one bucket
 
 _MARKS = frozenset(("start", "transition", "terminate"))
-_TICKS = frozenset(("error", "preempt", "control", "debug"))
+_TICKS = frozenset(EVENT_TICK_KINDS)
 _DEBUG_TICKS = frozenset(("mode", "hold", "forced"))  # a release follows every hold: its tick would say nothing new
 
 
@@ -165,7 +166,7 @@ class TimelineIndex:
             self._runs.append((run, seq, t))
             if len(self._runs) > MAX_TICKS:
                 self._runs = self._runs[-MAX_TICKS // 2:]
-            self._tick(seq, t, "run", "run " + run)
+            self._tick(seq, t, RUN_TICK, "run " + run)
 
     def _tick(self, seq: int, t: float, kind: str, text: str) -> None:
         self._ticks.append((seq, t, kind, text))

@@ -1,11 +1,14 @@
 // The page's address names what it shows: `#m=NAME` the machine, `&seq=N` the event looked back at,
 // so a copied address opens the same machine at the same instant.
 
-/** {machine, seq} the address names (null when it does not). */
+import { isMachineName } from "./schema.js";
+
+/** {machine, seq} the address names (null when it does not: a name no machine can have names none). */
 export function readLink() {
   const params = new URLSearchParams(location.hash.slice(1));
   const seq = Number(params.get("seq"));
-  return { machine: params.get("m"), seq: params.has("seq") && Number.isSafeInteger(seq) && seq >= 0 ? seq : null };
+  const machine = params.get("m");
+  return { machine: isMachineName(machine) ? machine : null, seq: params.has("seq") && Number.isSafeInteger(seq) && seq >= 0 ? seq : null };
 }
 
 /** Say in the address that the page shows machine `name`, at event `seq` (null: live). */

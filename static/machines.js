@@ -6,7 +6,7 @@ import { readLink, writeLink } from "./deeplink.js";
 import { holdChange } from "./loop.js";
 import { banner } from "./notice.js";
 import { h, setText } from "./dom.js";
-import { SOURCES } from "./schema.js";
+import { RUN_STATES, SOURCES, runState as schemaRunState } from "./schema.js";
 
 const POLL_MS = 2000;
 
@@ -27,12 +27,12 @@ export function controlRefusal(entry) {
 /** Whether the events of the machine of `entry` are a recording played again (their times tell no latency). */
 export const isReplay = (entry) => entry?.source === SOURCES.replay;
 
-/** running, done (reached an outcome), failed (ended without one after an error) or idle, from
- * status `s`; or disconnected: another process's machine whose publisher left before it ended
- * (`entry`: its /api/machines entry), so nobody can tell what it does now. */
+/** The run state (schema.js runState) of status `s` of the machine of `entry` (its /api/machines
+ * entry), as the dashboard words it: a machine whose process left is "disconnected" here (the
+ * fleet's tiles say "gone"). */
 export function runState(s, entry) {
-  const state = s.running ? "running" : s.outcome !== null && s.outcome !== undefined ? "done" : s.error ? "failed" : "idle";
-  return entry?.connected === false && (state === "running" || state === "idle") ? "disconnected" : state;
+  const state = schemaRunState(s.running, s.outcome, s.error, entry?.connected);
+  return state === RUN_STATES.gone ? "disconnected" : state;
 }
 
 /** The pill that says the run state of status `s` (null: none yet) of the machine of `entry`. */

@@ -39,6 +39,33 @@ export function containerKind(node) {
   return KIND_FIELDS.find(([field]) => field in node)?.[1] ?? "StateMachine";
 }
 
+// A machine's name (fsm/observation/names.py): 1 to MAX_NAME characters, none of / * $ ? # or a
+// control character, no space at either end; valid wherever a name travels.
+export const MAX_NAME = 200;
+const NAME_FORBIDDEN = /[\u002f\u002a\u0024\u003f\u0023\u0000\u0001\u0002\u0003\u0004\u0005\u0006\u0007\u0008\u0009\u000a\u000b\u000c\u000d\u000e\u000f\u0010\u0011\u0012\u0013\u0014\u0015\u0016\u0017\u0018\u0019\u001a\u001b\u001c\u001d\u001e\u001f\u007f]/;
+
+export function isMachineName(name) {
+  return typeof name === "string" && name.length > 0 && [...name].length <= MAX_NAME && !name.startsWith(" ")
+    && !name.endsWith(" ") && !NAME_FORBIDDEN.test(name);
+}
+
+// The words the server and the page share (fsm/observation/vocabularies.py).
+
+/** A machine's run states. */
+export const RUN_STATES = Object.freeze({"running": "running", "done": "done", "failed": "failed", "idle": "idle", "gone": "gone"});
+
+/** The run state of a machine: `running`, `outcome` and `error` from its status, `connected` from its
+ * /api/machines entry (false: its process left). Mirrors vocabularies.run_state. */
+export function runState(running, outcome, error, connected) {
+  if (running) return connected === false ? RUN_STATES.gone : RUN_STATES.running;
+  if (outcome !== null && outcome !== undefined) return RUN_STATES.done;
+  if (error !== null && error !== undefined) return RUN_STATES.failed;
+  return connected === false ? RUN_STATES.gone : RUN_STATES.idle;
+}
+
+/** The kinds of the timeline's ticks: an event of one of these kinds, or a run's start (the last). */
+export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug", "run"]);
+
 // The shapes: every event, every websocket frame, a machine's status and what it holds
 // (import one with /** @typedef {import("./schema.js").NAME} NAME */).
 

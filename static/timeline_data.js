@@ -2,9 +2,10 @@
 // and hit-tests from: one row per container (its bands as parallel typed arrays, labels as indices
 // into one table), the ticks sorted by time. Built once per answer, never per frame.
 
+import { TICK_KINDS } from "./schema.js";
+
 export const NO_LABEL = -1; // null: the container is not running
 export const MANY = -2; // "…": many states within one bucket
-export const TICK_KINDS = ["error", "preempt", "control", "debug", "run"];
 
 const segments = (path) => path.split("/").filter(Boolean);
 

@@ -21,7 +21,7 @@ from typing import Any, Callable
 
 from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
-from . import schema
+from . import names, schema
 from .encoding import encode_userdata
 from .schema import ABSENT, MAX_DOC, build
 from .structure import children, is_container
@@ -47,6 +47,7 @@ class Reporter:
         self._lock = threading.Lock()
         self._owner: int | None = None  # the thread delivering an event right now
         self._described_at = -1  # the construction generation of the last structure event
+        self._told: list[Observer] = []  # the observers whose failure was printed
 
     @property
     def last_seq(self) -> int:
@@ -88,7 +89,7 @@ class Reporter:
                 try:
                     observer(event)
                 except Exception:
-                    sys.stderr.write("fsm: an observer failed:\n" + traceback.format_exc())
+                    self._failed(observer)
         finally:
             self._owner = None
             lock.release()
@@ -119,6 +120,15 @@ class Reporter:
         self.send(_error, path, None if state is None else str(state), type(root).__name__, str(root),
                    "".join(traceback.format_exception(type(exc), exc, exc.__traceback__)),
                    type(exc).__name__ if root is not exc else ABSENT)
+
+    def _failed(self, observer: Observer) -> None:
+        """An observer could not take an event: said once per observer (with why), not per event,
+        since one that fails once usually fails on every event that follows."""
+        if any(o is observer for o in self._told):
+            return
+        self._told.append(observer)
+        sys.stderr.write("fsm: an observer of machine %r failed (its next failures are not printed):\n%s"
+                         % (self.machine, traceback.format_exc()))
 
     def begin_run(self) -> None:
         """Called by the root container as it starts: a new run id, then the structure if it
@@ -175,10 +185,13 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
 
 def attach(machine: Any, observer: Observer | None = None, name: str | None = None,
            path: str = DEFAULT_ROOT_PATH) -> Reporter:
-    """Observe a top-level container; a second call adds an observer to the same reporter."""
+    """Observe a top-level container; a second call adds an observer to the same reporter. ``name``
+    must keep the name rule (fsm/observation/names.py: ValueError saying why); without one the
+    machine is named after its root path."""
     rep = getattr(machine, "_reporter", None)
     if rep is None or rep.root is not machine:
-        rep = Reporter(machine, name or path.rsplit("/", 1)[-1] or "SM_ROOT", path)
+        name = names.check(name) if name else names.valid(path.rsplit("/", 1)[-1] or "SM_ROOT")
+        rep = Reporter(machine, name, path)
         machine._reporter = rep
         machine._path = path
         rep.structure()

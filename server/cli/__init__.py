@@ -13,6 +13,10 @@ A subcommand module has::
     def arguments(parser) -> None: ...  # its options
     def main(args) -> int: ...          # the exit code; import fastapi, uvicorn, sim in here, not at module level
 
+and, when some of its options mean nothing together, ``def unused(args, given) -> str | None``:
+what is wrong with the options ``given`` (the set of those given a value other than their
+default), said as the command's usage error (exit code 2) rather than silently ignored.
+
 To add one, write the module and list it in ``SUBCOMMANDS``.
 """
 
@@ -23,7 +27,7 @@ import sys
 from typing import Protocol
 
 from . import bag_import, demo, export, replay, router, run, serve
-from .serving import CannotServe
+from .cannot_serve import CannotServe
 
 
 class Subcommand(Protocol):
@@ -39,13 +43,27 @@ SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": repl
                                       "import": bag_import, "demo": demo, "router": router}
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The command line's parser, and each subcommand's."""
     parser = argparse.ArgumentParser(prog="fsmscope", description="Run, watch, record and replay SMACH-style state machines.")
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     commands.required = True
+    parsers = {}
     for name, sub in SUBCOMMANDS.items():
-        sub.arguments(commands.add_parser(name, help=sub.HELP, description=sub.HELP))
-    return parser
+        parsers[name] = commands.add_parser(name, help=sub.HELP, description=sub.HELP)
+        sub.arguments(parsers[name])
+    return parser, parsers
+
+
+def _refuse_unused(parser: argparse.ArgumentParser, args: argparse.Namespace) -> None:
+    """``parser``'s usage error (exit 2) when options of its command were given that mean nothing together."""
+    unused = getattr(SUBCOMMANDS[args.command], "unused", None)
+    if unused is None:
+        return
+    given = {dest for dest, value in vars(args).items() if value != parser.get_default(dest)}
+    problem = unused(args, given)
+    if problem:
+        parser.error(problem)
 
 
 def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
@@ -59,11 +77,12 @@ def _split_passed_on(argv: list[str]) -> tuple[list[str], list[str]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    parser, parsers = build_parser()
     own, passed_on = _split_passed_on(sys.argv[1:] if argv is None else list(argv))
     args, extra = parser.parse_known_args(own)
     if extra and not SUBCOMMANDS[args.command].PASSES_ARGUMENTS_ON:
         parser.error("unrecognized arguments: %s" % " ".join(extra))
+    _refuse_unused(parsers[args.command], args)
     args.extra = extra + passed_on
     try:
         return SUBCOMMANDS[args.command].main(args)

@@ -17,8 +17,8 @@ import threading
 import time
 from typing import Any
 
-from .fleet_bridge import add_zenoh_arguments, robot_follows, zenoh_robot
-from .serving import add_server_arguments, announce_viewer, start_server
+from .fleet_bridge import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
+from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, given_of, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"
 PASSES_ARGUMENTS_ON = False
@@ -36,6 +36,12 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     add_server_arguments(parser, 0)
     add_zenoh_arguments(parser, publish=True)
     parser.add_argument("--verbose", action="store_true", help="print the machine's info/debug log")
+
+
+def unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``."""
+    return ((args.headless and given_of(given, SERVER_OPTIONS, "has no meaning with --headless (no dashboard)"))
+            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT")) or None)
 
 
 def _quiet_loggers() -> None:
@@ -83,11 +89,17 @@ def main(args: argparse.Namespace) -> int:
     resume = threading.Event()
     hold = threading.Event()
     server = None
+    live = None
     try:
         if args.headless:
             if robot is not None:  # no loop waits for a start: it ends
                 fsm.attach(machine, robot, name=MACHINE_NAME)
                 robot.take_controls(MachineHandle(machine, rep, False, holder=hold.set))
+            if args.foxglove is not None:  # no hub to feed it: it observes the machine
+                from .foxglove_bridge import open_foxglove
+
+                live = open_foxglove(args.foxglove)
+                fsm.attach(machine, live.event)
         else:
             scene = demo.scene
             server = start_server(args, scene_url=scene.url if scene is not None else None,
@@ -133,6 +145,8 @@ def main(args: argparse.Namespace) -> int:
         worker.join(5.0)
         if server is not None:
             server.stop()
+        if live is not None:
+            live.stop()
         recorder.close()
         for s, h in old.items():
             signal.signal(s, h)

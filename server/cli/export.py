@@ -8,6 +8,8 @@ import argparse
 import os
 import sys
 
+from .serving import given_of
+
 HELP = "write a recorded run as one HTML file that shows it in the dashboard, from disk, with no server"
 PASSES_ARGUMENTS_ON = False
 EXIT_UNREADABLE = 2  # the log cannot be read or exported
@@ -25,6 +27,10 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--max-mb", type=float, default=MAX_MB,
                         help="refuse a log larger than this many megabytes (default %(default)s): the whole "
                              "run goes into the page, which the browser holds in memory")
+
+
+def unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    return given_of(given, ("max_mb",), "limits --html's page; --mcap writes any log") if args.mcap else None
 
 
 def main(args: argparse.Namespace) -> int:

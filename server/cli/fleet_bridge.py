@@ -20,7 +20,8 @@ from typing import TYPE_CHECKING, Callable
 from fsm.control.controls import Refused
 
 from ..remote_control import RemoteHandle, not_connected, remote_controls, taken
-from .serving import SWITCH_INTERVAL, CannotServe
+from .cannot_serve import CannotServe
+from .serving import SWITCH_INTERVAL
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -70,6 +71,7 @@ def zenoh_config_file(path: str) -> str:
 
 
 TOKEN_ENV = "FSMSCOPE_ZENOH_TOKEN"
+ZENOH_OPTIONS = ("zenoh_connect", "zenoh_listen", "zenoh_token", "zenoh_mode", "zenoh_scouting", "zenoh_config")
 
 
 def zenoh_tokens(args: argparse.Namespace) -> dict[str | None, str]:

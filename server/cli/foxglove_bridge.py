@@ -1,7 +1,9 @@
 """``--foxglove PORT``: the served machines on the Foxglove WebSocket protocol too
 (interop/foxglove_live.py), fed from the hub as a dashboard's websocket is: each machine's events
 from its feed's ring, on the server's event loop (where the ring changes), and its snapshot when it
-joins or falls further behind than the ring keeps."""
+joins or falls further behind than the ring keeps. A command that serves no dashboard (``run
+--no-serve``, ``demo --headless``) has no hub: it gives the server its machines' events by
+observing them (``fsm.attach(machine, live.event)``), in their threads."""
 
 from __future__ import annotations
 
@@ -11,6 +13,8 @@ import sys
 from typing import TYPE_CHECKING
 
 from fsm.observation.encoding import loads
+
+from .cannot_serve import CannotServe
 
 if TYPE_CHECKING:
     from interop.foxglove_live import FoxgloveLive
@@ -22,18 +26,27 @@ POLL_SECONDS = 0.05
 BATCH = 2000  # events of one machine taken per poll at most
 
 
-def start_foxglove(args: argparse.Namespace, hub: Hub) -> FoxgloveLive:
-    """The Foxglove server on 127.0.0.1 and ``--foxglove``, fed from ``hub`` until the process ends.
-    Foxglove's protocol has no token: it is never served on another address than the loopback,
-    whatever ``--host`` says (reach it from elsewhere through an SSH tunnel)."""
+def open_foxglove(port: int) -> FoxgloveLive:
+    """The Foxglove server on 127.0.0.1 and ``port``, said on stderr. Foxglove's protocol has no
+    token: it is never served on another address than the loopback, whatever ``--host`` says (reach
+    it from elsewhere through an SSH tunnel). Raises CannotServe."""
     from interop.foxglove_live import FoxgloveLive
 
     from .arm_frames import arm_frames
 
-    live = FoxgloveLive(LOOPBACK, args.foxglove, frames=arm_frames())
-    asyncio.run_coroutine_threadsafe(_pump(hub, live), hub.loop)
+    try:
+        live = FoxgloveLive(LOOPBACK, port, frames=arm_frames())
+    except RuntimeError as exc:  # foxglove-sdk's: the port is taken
+        raise CannotServe("the Foxglove server cannot start: %s" % exc) from exc
     print("fsmscope: Foxglove WebSocket at ws://%s:%d (no token: this computer only)" % (LOOPBACK, live.port),
           file=sys.stderr, flush=True)
+    return live
+
+
+def start_foxglove(args: argparse.Namespace, hub: Hub) -> FoxgloveLive:
+    """The Foxglove server on ``--foxglove``, fed from ``hub`` until the process ends."""
+    live = open_foxglove(args.foxglove)
+    asyncio.run_coroutine_threadsafe(_pump(hub, live), hub.loop)
     return live
 
 

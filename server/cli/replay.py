@@ -8,7 +8,7 @@ import math
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .serving import add_server_arguments, start_server, wait_for_interrupt
+from .serving import SERVER_OPTIONS, add_server_arguments, given_of, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
     from fsm.logfiles.log_reader import Reader
@@ -46,6 +46,18 @@ def play_speed(text: str) -> float:
     if not (math.isfinite(speed) and SPEEDS[0] <= speed <= SPEEDS[1]):
         raise argparse.ArgumentTypeError("%s is not within %g to %g" % (text, *SPEEDS))
     return speed
+
+
+def unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    """The dashboard's options without ``--serve``, the terminal's with it; and ``--foxglove``: a
+    replay is no live run (Foxglove opens the recording as a file, ``export --mcap``)."""
+    if args.foxglove is not None:
+        return ("--foxglove serves a live run's channels; a recorded one opens in Foxglove as a file: "
+                "fsmscope export %s --mcap OUT.mcap" % args.log)
+    if not args.serve:
+        return given_of(given, SERVER_OPTIONS + ("speed",), "needs --serve")
+    return given_of(given, ("json", "no_transcript", "no_time", "follow"),
+                    "has no meaning with --serve (the dashboard shows the whole log)")
 
 
 def main(args: argparse.Namespace) -> int:

@@ -11,7 +11,8 @@ import argparse
 import sys
 
 from .fleet_bridge import zenoh_config_file
-from .serving import CannotServe, wait_for_interrupt
+from .cannot_serve import CannotServe
+from .serving import wait_for_interrupt
 
 HELP = "route Zenoh for a fleet's robots and dashboards (a stand-in for zenohd)"
 PASSES_ARGUMENTS_ON = False

@@ -7,8 +7,9 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .fleet_bridge import add_zenoh_arguments, robot_follows, zenoh_robot
-from .serving import SWITCH_INTERVAL, add_server_arguments, announce_viewer, start_server, wait_for_interrupt
+from .fleet_bridge import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
+from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, given_of, start_server,
+                      wait_for_interrupt)
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -32,18 +33,38 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     add_zenoh_arguments(parser, publish=True)
 
 
-def main(args: argparse.Namespace) -> int:
-    import fsm
+def unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``."""
+    return ((args.no_serve and given_of(given, SERVER_OPTIONS, "has no meaning with --no-serve (no dashboard)"))
+            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT")) or None)
 
+
+def main(args: argparse.Namespace) -> int:
     from ..runner import Runner
 
     runner = Runner(args.script, list(args.extra), args.record)
     robot = zenoh_robot(args, can_start=True)
     if args.no_serve:
-        if robot is not None:
-            runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
-        return runner.run()
+        return run_unserved(args, runner, robot)
     return run_with_dashboard(args, runner, robot)
+
+
+def run_unserved(args: argparse.Namespace, runner: Runner, robot: ZenohRobot | None) -> int:
+    """The script's machines observed by the robot and the Foxglove server, when asked, and no dashboard."""
+    import fsm
+
+    from .foxglove_bridge import open_foxglove
+
+    if robot is not None:
+        runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
+    live = open_foxglove(args.foxglove) if args.foxglove is not None else None
+    if live is not None:
+        runner.on_machine.append(lambda name, container: fsm.attach(container, live.event))
+    try:
+        return runner.run()
+    finally:
+        if live is not None:
+            live.stop()
 
 
 def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRobot | None = None) -> int:

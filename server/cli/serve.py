@@ -7,8 +7,9 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .fleet_bridge import add_zenoh_arguments
-from .serving import CannotServe, add_server_arguments, announce_viewer, start_server, wait_for_interrupt
+from .fleet_bridge import ZENOH_OPTIONS, add_zenoh_arguments
+from .cannot_serve import CannotServe
+from .serving import add_server_arguments, announce_viewer, given_of, start_server, wait_for_interrupt
 
 HELP = "serve the dashboard for machines of other processes (they publish to /api/ingest)"
 PASSES_ARGUMENTS_ON = False
@@ -18,6 +19,10 @@ DEFAULT_PORT = 8765
 def arguments(parser: argparse.ArgumentParser) -> None:
     add_server_arguments(parser, DEFAULT_PORT)
     add_zenoh_arguments(parser, publish=False)
+
+
+def unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    return given_of(given, ZENOH_OPTIONS, "needs --zenoh") if args.zenoh is None else None
 
 
 def main(args: argparse.Namespace) -> int:

@@ -12,14 +12,10 @@ from typing import TYPE_CHECKING, Any
 from fsm.control.frames import DEADMAN_ACTIONS
 
 from ..lease import Deadman
+from .cannot_serve import CannotServe
 
 if TYPE_CHECKING:
     from ..http_server import ServerThread
-
-
-class CannotServe(Exception):
-    """The command cannot start with these arguments (the port is taken, a public address has no
-    token, Zenoh cannot open its session): it ends with exit code 1 and this reason."""
 
 
 def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> None:
@@ -44,6 +40,15 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
                              "arm's frames")
 
 
+SERVER_OPTIONS = ("host", "port", "token", "viewer", "deadman", "deadman_action")  # the dashboard's
+
+
+def given_of(given: set[str], options: tuple[str, ...], why: str) -> str | None:
+    """``--OPTION ... why`` for those of ``options`` that were ``given``; None when none was."""
+    found = ["--" + o.replace("_", "-") for o in options if o in given]
+    return "%s %s" % (", ".join(found), why) if found else None
+
+
 def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
     """The dashboard's server on ``--host/--port/--token``, started (and, with ``--foxglove``, the
     Foxglove server fed from its hub); ``options`` go to ``ServerThread`` (``scene_url``,
@@ -60,9 +65,9 @@ def start_server(args: argparse.Namespace, **options: Any) -> ServerThread:
 
         try:
             start_foxglove(args, srv.hub)
-        except RuntimeError as exc:  # foxglove-sdk's: the port is taken
+        except CannotServe:
             srv.stop()
-            raise CannotServe("the Foxglove server cannot start: %s" % exc) from exc
+            raise
     return srv
 
 

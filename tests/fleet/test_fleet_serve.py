@@ -13,7 +13,7 @@ import time
 import fsm
 import pytest
 from fleet_support import (ROOT, Dashboard, Proxy, Robot, free_endpoint, preempted_the_dashboard_has_the_robots_log,
-                           run_published, slow_loop)
+                           run_published, slow_loop, stop)
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
@@ -173,6 +173,30 @@ def test_a_script_run_with_zenoh_reaches_a_dashboard_as_the_robots_machine(tmp_p
     last = published(["run", str(script), *serving, "--zenoh", "arm2"], tmp_path / "pick.jsonl", endpoint)
     wait_for(lambda: seen and seen[-1]["seq"] == last, 10, what="the run's last event")
     assert {e["machine"] for e in seen} == {"arm2:pick"}
+
+
+EPISODES = ROOT / "tests" / "robots" / "episodes.py"
+
+
+def test_a_robot_that_builds_a_machine_per_episode_publishes_every_one_of_them(tmp_path, watching):
+    endpoint, seen = watching
+    stderr = tmp_path / "robot.err"
+    with open(stderr, "w") as err:
+        robot = subprocess.Popen([sys.executable, "-m", "server.cli", "run", str(EPISODES), "--no-serve", "--record",
+                                  str(tmp_path / "r1.jsonl"), "--zenoh", "r1", "--zenoh-connect", endpoint,
+                                  "--zenoh-token", "T"], cwd=ROOT, stderr=err, start_new_session=True)
+    names = ["r1:episodes"] + ["r1:episodes-%d" % i for i in range(2, 11)]
+    try:
+        wait_for(lambda: {e["machine"] for e in seen if e["kind"] == "terminate" and e["outcome"] == "done"
+                          and e["path"] == "/SM_ROOT"} == set(names), 30,
+                 what=lambda: "ten machines ended, seen: %s" % sorted({e["machine"] for e in seen}))
+    finally:
+        stop(robot)
+    recorded = list(read_events(str(tmp_path / "r1.jsonl")))
+    for name in names:
+        assert [e["seq"] for e in seen if e["machine"] == name] == [
+            e["seq"] for e in recorded if "r1:" + e["machine"] == name and e["kind"] != "snapshot"], name
+    assert "an observer" not in stderr.read_text()
 
 
 def test_a_script_that_never_closes_its_robot_still_exits(tmp_path):

@@ -60,7 +60,7 @@ def test_run_names_a_second_machine_after_the_script_with_a_number(tmp_path):
     log = tmp_path / "twice.jsonl"
     assert cli("run", script, "--record", log).returncode == 0
     summary = json.loads(cli("replay", log, "--json").stdout)
-    assert list(summary["machines"]) == ["twice", "twice#2"]
+    assert list(summary["machines"]) == ["twice", "twice-2"]
 
 
 def test_run_accepts_no_serve_and_exit(tmp_path):
@@ -270,3 +270,26 @@ def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_lo
         assert machines["foo_bar"]["replay"] == {"speed": 2.0}
         preempt = httpx.post(base + "/api/machines/foo_bar/preempt", json={}, headers=headers)
         assert preempt.status_code == 409 and "replayed" in preempt.json()["detail"]
+
+
+@pytest.mark.parametrize("command, refused", [
+    (["run", "SCRIPT", "--no-serve", "--viewer"], "--viewer has no meaning with --no-serve"),
+    (["run", "SCRIPT", "--no-serve", "--port", "9999", "--deadman", "7.5"], "--port, --deadman has no meaning"),
+    (["run", "SCRIPT", "--zenoh-connect", "tcp/127.0.0.1:7447"], "--zenoh-connect needs --zenoh ROBOT"),
+    (["demo", "--headless", "--host", "0.0.0.0"], "--host has no meaning with --headless"),
+    (["demo", "--headless", "--zenoh-token", "T"], "--zenoh-token needs --zenoh ROBOT"),
+    (["serve", "--zenoh-scouting"], "--zenoh-scouting needs --zenoh"),
+    (["replay", "LOG", "--speed", "2"], "--speed needs --serve"),
+    (["replay", "LOG", "--token", "t"], "--token needs --serve"),
+    (["replay", "LOG", "--serve", "--follow"], "--follow has no meaning with --serve"),
+    (["replay", "LOG", "--serve", "--json"], "--json has no meaning with --serve"),
+    (["replay", "LOG", "--serve", "--foxglove", "0"], "--foxglove serves a live run's channels; a recorded one "
+                                                       "opens in Foxglove as a file: fsmscope export"),
+    (["export", "LOG", "--mcap", "OUT", "--max-mb", "1"], "--max-mb limits --html's page"),
+], ids=lambda v: " ".join(v) if isinstance(v, list) else "")
+def test_options_that_mean_nothing_together_are_refused_with_why(command, refused, foo_bar_log, tmp_path):
+    args = [{"SCRIPT": os.path.join(EXAMPLES, "foo_bar.py"), "LOG": str(foo_bar_log), "OUT": str(tmp_path / "o.mcap")
+             }.get(a, a) for a in command]
+    done = subprocess.run([sys.executable, "-m", "server.cli", *args], cwd=ROOT, capture_output=True, text=True,
+                          timeout=30, env=dict(os.environ, PYTHONPATH=ROOT))
+    assert done.returncode == 2 and refused in done.stderr, done.stderr

@@ -1,5 +1,6 @@
 """`--foxglove PORT`: a Foxglove client (a real websocket, Foxglove's subprotocol) connected to the
-foxglove-sdk server that the hub feeds sees the machine's channels and its active state change."""
+foxglove-sdk server that the hub feeds sees the machine's channels and its active state change; so
+does one connected to a command that serves no dashboard (`run --no-serve`, `demo --headless`)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,13 @@ import argparse
 import asyncio
 import concurrent.futures
 import json
+import os
+import queue
+import re
+import signal
 import socket
+import subprocess
+import sys
 import threading
 
 import fsm
@@ -15,6 +22,7 @@ import pytest
 import websockets
 from recording_support import two_state_loop
 
+from recording_support import ROOT
 from server.cli.foxglove_bridge import start_foxglove
 from server.http_server import ServerThread
 
@@ -90,3 +98,102 @@ def test_the_foxglove_server_listens_on_the_loopback_only_whatever_host_says():
             live.stop()
     finally:
         srv.stop()
+
+
+async def first_messages(port: int, topic: str, want: int) -> list[dict]:
+    """The first ``want`` messages of ``topic`` once a client has subscribed to it."""
+    async with websockets.connect("ws://127.0.0.1:%d" % port, subprotocols=[SUBPROTOCOL], close_timeout=0.5) as ws:
+        channels = {}
+        while topic not in channels:
+            frame = await asyncio.wait_for(ws.recv(), 20)
+            if isinstance(frame, str) and json.loads(frame)["op"] == "advertise":
+                channels.update({c["topic"]: c for c in json.loads(frame)["channels"]})
+        await ws.send(json.dumps({"op": "subscribe", "subscriptions": [{"id": 1, "channelId": channels[topic]["id"]}]}))
+        got = []
+        while len(got) < want:
+            frame = await asyncio.wait_for(ws.recv(), 20)
+            if isinstance(frame, bytes) and frame[0] == 1:
+                got.append(json.loads(frame[1 + 4 + 8:]))
+        return got
+
+
+def foxglove_port_of(command: list[str], timeout: float = 30.0) -> tuple[subprocess.Popen, int]:
+    """``fsmscope COMMAND`` in a real process, and the port of the Foxglove server it says it serves
+    (AssertionError with what it said when it says none within ``timeout`` seconds)."""
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", *command], cwd=ROOT, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env=dict(os.environ, PYTHONPATH=ROOT))
+    lines: queue.Queue = queue.Queue()
+    threading.Thread(target=lambda: [lines.put(line) for line in proc.stderr] and None, daemon=True).start()
+    said = []
+    try:
+        while True:
+            said.append(lines.get(timeout=timeout))
+            found = re.search(r"Foxglove WebSocket at ws://127\.0\.0\.1:(\d+)", said[-1])
+            if found:
+                return proc, int(found.group(1))
+    except queue.Empty:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(10)
+        raise AssertionError("fsmscope %s said no Foxglove server: %r" % (command[0], said)) from None
+
+
+LOOPING = """
+import time
+import fsm
+sm = fsm.StateMachine(["done"])
+ticks = [0]
+def tick(ud):
+    time.sleep(0.02)
+    ticks[0] += 1
+    return "stop" if ticks[0] >= 1500 else "go"
+with sm:
+    fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["go", "stop"]), {"go": "B", "stop": "done"})
+    fsm.StateMachine.add("B", fsm.CBState(tick, outcomes=["go", "stop"]), {"go": "A", "stop": "done"})
+sm.execute()
+"""
+
+
+def states_seen(command: list[str], topic: str) -> set[str]:
+    """The active states ``topic`` says to a Foxglove client of ``fsmscope COMMAND``."""
+    proc, port = foxglove_port_of(command)
+    try:
+        with concurrent.futures.ThreadPoolExecutor(1) as own_loop:
+            states = own_loop.submit(asyncio.run, first_messages(port, topic, 10)).result()
+    finally:
+        os.killpg(proc.pid, signal.SIGTERM)
+        proc.wait(20)
+    return {s["active"] for s in states}
+
+
+def test_a_script_run_without_a_dashboard_serves_foxglove_its_active_states(tmp_path):
+    script = tmp_path / "looping.py"
+    script.write_text(LOOPING)
+    seen = states_seen(["run", str(script), "--no-serve", "--foxglove", "0", "--record", str(tmp_path / "r.jsonl")],
+                       "/fsmscope/looping/state")
+    assert seen >= {"/SM_ROOT/A", "/SM_ROOT/B"}
+
+
+def test_the_headless_demo_serves_foxglove_its_active_states(tmp_path):
+    seen = states_seen(["demo", "--headless", "--fast", "--foxglove", "0", "--record", str(tmp_path / "d.jsonl")],
+                       "/fsmscope/pick_place/state")
+    assert len(seen) >= 2 and all(s.startswith("/SM_ROOT") for s in seen)
+
+
+def test_a_client_offering_only_the_older_foxglove_websocket_v1_is_refused():
+    """docs/interop.md: foxglove-sdk speaks foxglove.sdk.v1 only (what @foxglove/ws-protocol 0.8.0 offers is refused)."""
+    from interop.foxglove_live import FoxgloveLive
+
+    live = FoxgloveLive(port=0)
+
+    async def offer(subprotocol: str) -> None:
+        async with websockets.connect("ws://127.0.0.1:%d" % live.port, subprotocols=[subprotocol], close_timeout=0.5):
+            pass
+    try:
+        with concurrent.futures.ThreadPoolExecutor(1) as own_loop:
+            own_loop.submit(asyncio.run, offer(SUBPROTOCOL)).result()
+            with pytest.raises(websockets.InvalidStatus) as refused:
+                own_loop.submit(asyncio.run, offer("foxglove.websocket.v1")).result()
+    finally:
+        live.stop()
+    assert refused.value.response.status_code == 400

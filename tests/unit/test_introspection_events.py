@@ -310,3 +310,26 @@ def test_seq_is_strictly_increasing_across_concurrent_children(observe, logs):
     seqs = [e["seq"] for e in events]
     assert len(events) > 5 * 200
     assert all(later > earlier for earlier, later in zip(seqs, seqs[1:]))
+
+
+def test_an_observer_that_cannot_take_events_is_reported_once_and_the_others_get_every_event(observe, logs, capsys):
+    def refuses(event):
+        raise ValueError("cannot take %s" % event["kind"])
+
+    sm = _nested()
+    smach.attach(sm, refuses, name="picker")
+    events = observe(sm)
+    try:
+        sm.execute()
+        sm.execute()
+    finally:
+        introspection.reporter_of(sm).remove_observer(refuses)
+    told = capsys.readouterr().err
+    assert told.count("an observer of machine 'picker' failed") == 1
+    assert "ValueError: cannot take structure" in told
+    assert [e["kind"] for e in events].count("terminate") == 4
+
+
+def test_a_machine_attached_under_a_name_no_key_or_address_can_hold_is_refused_at_once():
+    with pytest.raises(ValueError, match=r"a machine's name must not hold '#'"):
+        smach.attach(_nested(), name="task#2")

@@ -8,9 +8,10 @@ import math
 from dataclasses import dataclass
 from typing import Any, Callable
 
+from ..names import MAX_NAME, is_valid as is_name
+
 VERSION = 1
 MAX_SEQ = 2 ** 53 - 1          # the browser's largest exact integer
-MAX_NAME = 200                 # a machine's name
 MAX_PATH = 4096                # a container or state path
 MAX_STRUCTURE_DEPTH = 64       # container levels; JSON encoders refuse much deeper nesting
 MAX_STRUCTURE_NODES = 200_000
@@ -83,7 +84,8 @@ STR = simple("a string", (str,))
 BOOL = simple("a boolean", (bool,))
 NUMBER = simple("a finite number", (float, int), lambda v: type(v) is int or math.isfinite(v))
 SEQ = simple("an integer from 0 to 2^53-1", (int,), lambda v: 0 <= v <= MAX_SEQ)
-NAME = simple("a string of 1 to %d characters" % MAX_NAME, (str,), lambda v: 0 < len(v) <= MAX_NAME)
+NAME = simple("a name of 1 to %d characters (no / * $ ? #, control character or outer space)" % MAX_NAME,
+              (str,), is_name)
 PATH = simple("a string of 1 to %d characters" % MAX_PATH, (str,), lambda v: 0 < len(v) <= MAX_PATH)
 OPT_STR = nullable(STR)
 OPT_NUMBER = nullable(NUMBER)

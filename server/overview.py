@@ -15,11 +15,12 @@ import collections
 import time
 from typing import TYPE_CHECKING
 
+from fsm.observation import schema
+
 if TYPE_CHECKING:
     from .hub import Hub, MachineEntry
 
 RATE_WINDOW = 5.0  # seconds of samples the event rate is the mean over
-STATES = ("running", "failed", "done", "idle", "gone")
 
 
 def state_of(entry: MachineEntry) -> str:
@@ -46,7 +47,7 @@ class Overview:
         self._seen: dict[str, tuple[int, float]] = {}  # name: (last_seq, when it was first seen at that seq)
 
     def tiles(self) -> list[dict]:
-        """Every machine's tile, in the hub's order, sampled now."""
+        """Every machine's tile (``schema.TILE``), in the hub's order, sampled now."""
         now, wall = time.monotonic(), time.time()
         entries = self.hub.machines()
         names = {entry.name for entry in entries}
@@ -71,8 +72,9 @@ class Overview:
             # First sight: when its newest event was made (never later than now); then: when it changed.
             seen = (seq, min(last_t or wall, wall) if seen is None else wall)
             self._seen[entry.name] = seen
-        return {"name": entry.name, "robot": entry.robot, "machine": entry.name.partition(":")[2] if entry.robot
-                else entry.name, "source": entry.source, "state": state_of(entry), "outcome": outcome,
-                "error": error.get("exc_type") or error.get("message") or None, "active": active,
-                "rate": round(rate, 1), "last_seq": seq, "last_seen": seen[1] if seq else None,
-                "connected": entry.connected is not False}
+        return schema.tile(name=entry.name, robot=entry.robot,
+                           machine=entry.name.partition(":")[2] if entry.robot else entry.name, source=entry.source,
+                           state=state_of(entry), outcome=outcome,
+                           error=error.get("exc_type") or error.get("message") or None, active=active,
+                           rate=round(rate, 1), last_seq=seq, last_seen=seen[1] if seq else None,
+                           connected=entry.connected is not False)

@@ -67,6 +67,9 @@ export const KINDS = Object.freeze(%(kinds)s);
 /** Where a served machine's events come from. */
 export const SOURCES = Object.freeze(%(sources)s);
 
+/** A fleet overview tile's states, in the order that needs a look first. */
+export const TILE_STATES = Object.freeze(%(tile_states)s);
+
 // Graph element ids: a path can hold any character; control characters and '%%' are
 // percent-escaped (one to one), as the server's SVG writes them.
 const ESCAPED = new Map(Object.entries(%(escapes)s));
@@ -100,7 +103,7 @@ export function containerKind(node) {
 // (import one with /** @typedef {import("./schema.js").NAME} NAME */).
 
 %(typedefs)s""" % {"typedefs": typedefs(), "version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
-       "sources": json.dumps({s: s for s in schema.SOURCES}),
+       "sources": json.dumps({s: s for s in schema.SOURCES}), "tile_states": json.dumps(list(schema.TILE_STATES)),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
        "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),

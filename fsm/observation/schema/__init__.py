@@ -9,6 +9,7 @@ One package, one module per concept:
 * ``events``: the envelope, each kind's fields, and ``build``, the one way each kind is made;
 * ``messages``: the websocket frames around the events (snapshot, events, missed, pace, ...), beside
   them as in viser's one message module;
+* ``tile``: the fleet overview's tile of a machine, and ``tile``, its maker;
 * ``validation``: ``validate``, which says in words what is wrong with an event from outside;
 * ``ids``: the graph's element ids (``s:``, ``c:``, ``o:``, ``e:``), shared by the server's SVG and the page.
 
@@ -17,7 +18,7 @@ publisher's snapshots, the server's control events) and frames with ``messages``
 event comes in through from outside calls ``validate``. The browser's ``static/schema.js`` (its
 constants and JSDoc typedefs) and the field tables of ``docs/events.md`` are generated from here
 (``python -m server.schema_export``); a test fails when they differ. The REST models of
-server/models.py are tested against the status and breakpoint shapes.
+server/models.py are tested against the status, breakpoint and tile shapes.
 
 Everything is importable from ``fsm.observation.schema`` itself. Standard library only, like the rest of ``fsm``.
 """
@@ -33,6 +34,7 @@ from .messages import (DEADMAN_ACTIONS, HISTORY_FIELDS, HISTORY_LIMIT, MAX_PACE_
 from .status import (AT, BREAKPOINT, BREAKPOINT_FIELDS, CONTAINER_STATUS_FIELDS, DEBUG_ACTIONS, DEBUG_MODES,
                      DEBUG_STATUS_FIELDS, HOLD_FIELDS, LAST_TRANSITION_FIELDS, POSE_FIELDS, POSITIONS, PREEMPT_FIELDS,
                      STATUS, STATUS_FIELDS)
+from .tile import TILE, TILE_FIELDS, TILE_STATES, tile
 from .tree import (CONTAINER_FIELDS, CONTAINER_TYPES, KIND_FIELDS, NODE, NODE_FIELDS, TRANSITION_FIELDS,
                    container_fields, container_kind, edge, node, node_problem)
 from .validation import DEBUG_NEEDS, validate
@@ -47,7 +49,7 @@ __all__ = [
     "frame", "frame_problem", "list_frame", "with_history",
     "AT", "BREAKPOINT", "BREAKPOINT_FIELDS", "CONTAINER_STATUS_FIELDS", "DEBUG_ACTIONS", "DEBUG_MODES",
     "DEBUG_STATUS_FIELDS", "HOLD_FIELDS", "LAST_TRANSITION_FIELDS", "POSE_FIELDS", "POSITIONS", "PREEMPT_FIELDS",
-    "STATUS", "STATUS_FIELDS",
+    "STATUS", "STATUS_FIELDS", "TILE", "TILE_FIELDS", "TILE_STATES", "tile",
     "CONTAINER_FIELDS", "CONTAINER_TYPES", "KIND_FIELDS", "NODE", "NODE_FIELDS", "TRANSITION_FIELDS",
     "container_fields", "container_kind", "edge", "node", "node_problem", "DEBUG_NEEDS", "validate",
 ]

@@ -16,6 +16,7 @@ from .events import EVENT
 from .fields import (BOOL, JSON, LIST_STR, NAME, NUMBER, OBJECT, SEQ, STR, Field, fields_problem, list_of,
                      maker, object_of, one_of, shape, simple)
 from .status import BREAKPOINT, STATUS
+from .tile import TILE
 
 MAX_PACE_MS = 10_000  # the slowest pace a page may ask for
 DEADMAN_ACTIONS = ("pause", "preempt", "none")  # what a publisher does itself when an operator's link is gone
@@ -53,7 +54,7 @@ MESSAGES: dict[str, Message] = {m.name: m for m in (
             "the one before (0: each as it comes).", (Field("ms", PACE_MS),)),
     Message("overview", "server to page", "The fleet overview's tiles (GET /api/overview's), at most once a "
             "second.", (Field("now", NUMBER, doc="the server's clock"),
-                        Field("tiles", list_of(OBJECT, "a list of tiles"), doc="as GET /api/overview"))),
+                        Field("tiles", list_of(TILE, "a list of tiles"), doc="as GET /api/overview"))),
     Message("hello", "publisher to server", "Which of its machines take controls (and may be started again): "
             "first on each connection, again when a machine is attached.", (
                 Field("controllable", LIST_STR, doc="machine names"),

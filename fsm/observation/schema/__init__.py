@@ -6,7 +6,8 @@ One package, one module per concept:
 * ``tree``: the structure tree a ``structure`` event carries, and the makers of its parts;
 * ``status``: a machine's status (``fsm.observation.status.Status.to_dict()``), its debugger's state,
   holds and breakpoints;
-* ``events``: the envelope, each kind's fields, and ``build``, the one way each kind is made;
+* ``events``: the envelope, each kind's fields, and ``build``, the one way each kind is made
+  (``fields_of``: a kind's own fields, without the envelope);
 * ``messages``: the websocket frames around the events (snapshot, events, missed, pace, ...), beside
   them as in viser's one message module;
 * ``tile``: the fleet overview's tile of a machine, and ``tile``, its maker;
@@ -23,7 +24,7 @@ server/models.py are tested against the status, breakpoint and tile shapes.
 Everything is importable from ``fsm.observation.schema`` itself. Standard library only, like the rest of ``fsm``.
 """
 
-from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, event
+from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, event, fields_of
 from .fields import (ABSENT, BODY_POSE, BOOL, JSON, LIST_STR, MAP_BODY_POSE, MAP_NUMBER, MAP_OPT_STR, MAP_STR,
                      MAX_DOC, MAX_NAME, MAX_PATH, MAX_SEQ, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES, MAX_VALUE_DEPTH,
                      NAME, NUMBER, OBJECT, OPT_NUMBER, OPT_STR, PATH, SEQ, SHAPES, STR, VERSION, Field, Kind, Type,
@@ -40,7 +41,7 @@ from .tree import (CONTAINER_FIELDS, CONTAINER_TYPES, KIND_FIELDS, NODE, NODE_FI
 from .validation import DEBUG_NEEDS, validate
 
 __all__ = [
-    "ABSENT", "ENVELOPE", "EVENT", "KINDS", "SOURCES", "argument", "build", "event",
+    "ABSENT", "ENVELOPE", "EVENT", "KINDS", "SOURCES", "argument", "build", "event", "fields_of",
     "MAX_DOC", "MAX_NAME", "MAX_PATH", "MAX_SEQ", "MAX_STRUCTURE_DEPTH", "MAX_STRUCTURE_NODES", "MAX_VALUE_DEPTH",
     "SHAPES", "VERSION", "Field", "Kind", "Type", "BODY_POSE", "BOOL", "JSON", "LIST_STR", "MAP_BODY_POSE",
     "MAP_NUMBER", "MAP_OPT_STR", "MAP_STR", "NAME", "NUMBER", "OBJECT", "OPT_NUMBER", "OPT_STR", "PATH", "SEQ", "STR",

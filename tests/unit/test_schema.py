@@ -122,6 +122,13 @@ def test_a_kinds_own_fields_are_its_events_without_the_envelope():
     assert schema.fields_of.pose(joints) == {"joints": joints}
 
 
+@pytest.mark.parametrize("name", list(schema.MESSAGES))
+def test_a_frames_field_names_are_in_the_order_its_maker_takes_them(name):
+    made = getattr(schema.frame, name)(*schema.field_names(name))
+    assert list(made) == ["type", *schema.field_names(name)]
+    assert [made[field] for field in schema.field_names(name)] == list(schema.field_names(name))
+
+
 def test_the_reducers_status_holds_the_fields_of_the_schemas_status_and_no_other():
     from fsm.observation.status import Status
 

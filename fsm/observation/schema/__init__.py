@@ -31,7 +31,7 @@ from .fields import (ABSENT, BODY_POSE, BOOL, JSON, LIST_STR, MAP_BODY_POSE, MAP
                      argument)
 from .ids import ID_ESCAPES, ID_PREFIXES, container_id, edge_id, id_text, outcome_id, state_id
 from .messages import (DEADMAN_ACTIONS, HISTORY_FIELDS, HISTORY_LIMIT, MAX_PACE_MS, MESSAGES, Message,
-                       encoded_history, frame, frame_problem, list_frame, with_history)
+                       encoded_history, field_names, frame, frame_problem, list_frame, with_history)
 from .status import (AT, BREAKPOINT, BREAKPOINT_FIELDS, CONTAINER_STATUS_FIELDS, DEBUG_ACTIONS, DEBUG_MODES,
                      DEBUG_STATUS_FIELDS, HOLD_FIELDS, LAST_TRANSITION_FIELDS, POSE_FIELDS, POSITIONS, PREEMPT_FIELDS,
                      STATUS, STATUS_FIELDS)
@@ -47,7 +47,7 @@ __all__ = [
     "MAP_NUMBER", "MAP_OPT_STR", "MAP_STR", "NAME", "NUMBER", "OBJECT", "OPT_NUMBER", "OPT_STR", "PATH", "SEQ", "STR",
     "ID_ESCAPES", "ID_PREFIXES", "container_id", "edge_id", "id_text", "outcome_id", "state_id",
     "DEADMAN_ACTIONS", "HISTORY_FIELDS", "HISTORY_LIMIT", "MAX_PACE_MS", "MESSAGES", "Message", "encoded_history",
-    "frame", "frame_problem", "list_frame", "with_history",
+    "field_names", "frame", "frame_problem", "list_frame", "with_history",
     "AT", "BREAKPOINT", "BREAKPOINT_FIELDS", "CONTAINER_STATUS_FIELDS", "DEBUG_ACTIONS", "DEBUG_MODES",
     "DEBUG_STATUS_FIELDS", "HOLD_FIELDS", "LAST_TRANSITION_FIELDS", "POSE_FIELDS", "POSITIONS", "PREEMPT_FIELDS",
     "STATUS", "STATUS_FIELDS", "TILE", "TILE_FIELDS", "TILE_STATES", "tile",

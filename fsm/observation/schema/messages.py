@@ -3,7 +3,8 @@ for every message), each a JSON object whose ``type`` says which.
 
 The page's stream (docs/api.md, "Stream") and the fleet overview's, and the publisher's link to the
 server (docs/api.md, "Ingest"). ``frame.NAME(...)`` makes each, as ``build`` makes events (the
-fields in their order, optional ones by keyword); ``static/schema.js`` carries their JSDoc typedefs.
+fields in their order, optional ones by keyword) and ``field_names(NAME)`` names what a reader reads;
+``static/schema.js`` carries their JSDoc typedefs.
 """
 
 from __future__ import annotations
@@ -79,6 +80,13 @@ MESSAGES: dict[str, Message] = {m.name: m for m in (
 
 # ``frame.NAME(...)``: the one way each frame is made.
 frame = SimpleNamespace(**{name: maker(name, (("type", repr(name)),), m.fields, m.doc) for name, m in MESSAGES.items()})
+
+
+def field_names(name: str) -> tuple[str, ...]:
+    """A frame's field names in their definition's order, the order its maker takes them: what a reader
+    of the frame unpacks (``machine, held, after, action = field_names("lease")``), so that a field
+    renamed here is renamed there, and one added or removed fails the reader's import."""
+    return tuple(f.name for f in MESSAGES[name].fields)
 
 
 def frame_problem(message: Any) -> str | None:

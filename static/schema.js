@@ -251,7 +251,7 @@ export function containerKind(node) {
  * The machine's whole state: the first frame of a stream (unless it resumes), and again after missed (server to page).
  * @typedef {Object} SnapshotFrame
  * @property {"snapshot"} type
- * @property {MachineStatus} status the machine's status with its structure (below)
+ * @property {MachineStatus} status the machine's status with its structure (docs/events.md)
  * @property {number} last_seq the seq of the last event the status includes
  * @property {History} [history] a new connection's only: the current run's events up to last_seq, for the log (already in the status: not to be applied again)
  */
@@ -278,7 +278,7 @@ export function containerKind(node) {
  */
 
 /**
- * The fleet overview's tiles (GET /api/overview's), at most once a second (server to page).
+ * The fleet overview's tiles (GET /api/overview's), at most twice a second, when a tile changed (server to page).
  * @typedef {Object} OverviewFrame
  * @property {"overview"} type
  * @property {number} now the server's clock
@@ -286,11 +286,11 @@ export function containerKind(node) {
  */
 
 /**
- * Which of its machines take controls (and may be started again): first on each connection, again when a machine is attached (publisher to server).
+ * Which of its machines take controls (and may be started again): first on each connection, again when a machine is attached; each replaces the last (publisher to server).
  * @typedef {Object} HelloFrame
  * @property {"hello"} type
  * @property {Array<string>} controllable machine names
- * @property {Object<string, boolean>} can_start {name: bool}
+ * @property {Object<string, boolean>} can_start {name: whether it may be started again}
  */
 
 /**
@@ -299,8 +299,8 @@ export function containerKind(node) {
  * @property {"control"} type
  * @property {number} id its answer carries it
  * @property {string} machine
- * @property {string} action
- * @property {Object<string, *>} params
+ * @property {string} action what to do (below)
+ * @property {Object<string, *>} params the action's (below)
  * @property {string} client who asked
  */
 
@@ -316,13 +316,13 @@ export function containerKind(node) {
  */
 
 /**
- * The operator lease of one of its machines was taken, released or lapsed (server to publisher).
+ * The operator lease of one of its machines was taken, released or lapsed; sent again when the publisher reconnects (server to publisher).
  * @typedef {Object} LeaseFrame
  * @property {"lease"} type
  * @property {string} machine
  * @property {boolean} held
  * @property {number} after seconds
- * @property {("pause"|"preempt"|"none")} action what the publisher does itself when its link is gone that long
+ * @property {("pause"|"preempt"|"none")} action while it is held, what the publisher does itself when its link is gone that long
  */
 
 /**
@@ -457,13 +457,13 @@ export function containerKind(node) {
  * @property {string} name the dashboard's name of the machine (a robot's: robot:machine)
  * @property {(string|null)} robot the robot publishing it on Zenoh (null for the others)
  * @property {string} machine its name on its robot (its name, for the others)
- * @property {("local"|"ingest"|"replay")} source
+ * @property {("local"|"ingest"|"replay")} source where its events come from (GET /api/machines' source)
  * @property {("failed"|"gone"|"running"|"idle"|"done")} state failed: its run ended on an error; gone: its process went away while it ran or idled; done: it reached an outcome
  * @property {(string|null)} outcome the outcome its run reached
  * @property {(string|null)} error the exception type of a failed run
  * @property {Array<string>} active the full paths of its active states (leaves)
  * @property {number} rate events per second over the last 5 s, as the server received them
- * @property {number} last_seq
+ * @property {number} last_seq its newest event's
  * @property {(number|null)} last_seen when the server saw its newest event (Unix time, the server's clock; null before any)
  * @property {boolean} connected false when the process that publishes it has gone away
  */

@@ -29,7 +29,7 @@ if TYPE_CHECKING:
 ANSWER_TIMEOUT = 5.0  # seconds a control waits for the publishing process's answer (then 504)
 # The fields of the publisher's frames read here, as their definitions (schema/messages.py) name them.
 _CONTROLLABLE, _CAN_START = schema.field_names("hello")
-_ANSWER_ID, *_ = schema.field_names("answer")
+_ANSWER_ID = schema.field_names("answer")[0]  # its first field: the control's id
 
 
 def not_connected(name: str) -> ControlError:

@@ -3,8 +3,8 @@ history, a timeline, the states' statistics, and the few answers of the pages; O
 from these. The controls' requests and answers are server/control_models.py.
 
 The shapes the schema defines (fsm/observation/schema/: a machine's status and what it holds, a
-breakpoint, a structure node) are restated here for OpenAPI's sake, with their descriptions, and
-tests/unit/test_models_schema.py fails when a model and its shape in the schema differ."""
+breakpoint, a structure node, a fleet overview tile) are restated here for OpenAPI's sake, with their
+descriptions, and tests/unit/test_models_schema.py fails when a model and its shape in the schema differ."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import Any, Literal, Optional
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from fsm.observation.schema import SOURCES
+from fsm.observation.schema import SOURCES, TILE_STATES
 
 JsonValue = Any
 
@@ -75,13 +75,15 @@ class MachineInfo(BaseModel):
 
 
 class Tile(BaseModel):
-    """A machine's tile on the fleet overview (server/overview.py)."""
+    """A machine's tile on the fleet overview (server/overview.py; ``schema.TILE``)."""
     name: str = Field(description="the dashboard's name of the machine (a robot's: robot:machine)")
     robot: Optional[str] = Field(default=None, description="the robot publishing it on Zenoh (null for the others)")
     machine: str = Field(description="its name on its robot (its name, for the others)")
     source: Literal[SOURCES]  # type: ignore[valid-type]
-    state: Literal["running", "failed", "done", "idle", "gone"]
-    outcome: Optional[str] = None
+    state: Literal[TILE_STATES] = Field(  # type: ignore[valid-type]
+        description="failed: its run ended on an error; gone: its process went away while it ran or idled; "
+                    "done: it reached an outcome")
+    outcome: Optional[str] = Field(default=None, description="the outcome its run reached")
     error: Optional[str] = Field(default=None, description="the exception type of a failed run")
     active: list[str] = Field(description="the full paths of its active states (leaves)")
     rate: float = Field(description="events per second over the last 5 s, as the server received them")

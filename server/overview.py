@@ -15,6 +15,7 @@ import collections
 import time
 from typing import TYPE_CHECKING
 
+from fsm.observation import schema
 from fsm.observation.vocabularies import run_state
 
 if TYPE_CHECKING:
@@ -39,7 +40,7 @@ class Overview:
         self._seen: dict[str, tuple[int, float]] = {}  # name: (last_seq, when it was first seen at that seq)
 
     def tiles(self) -> list[dict]:
-        """Every machine's tile, in the hub's order, sampled now."""
+        """Every machine's tile (``schema.TILE``), in the hub's order, sampled now."""
         now, wall = time.monotonic(), time.time()
         entries = self.hub.machines()
         names = {entry.name for entry in entries}
@@ -66,8 +67,9 @@ class Overview:
             seen = (seq, min(last_t or wall, wall) if seen is None else wall)
             self._seen[entry.name] = seen
         origin = entry.origin
-        return {"name": entry.name, "robot": origin.robot, "machine": entry.name.partition(":")[2] if origin.robot
-                else entry.name, "source": origin.source, "state": state_of(entry), "outcome": outcome,
-                "error": error.get("exc_type") or error.get("message") or None, "active": active,
-                "rate": round(rate, 1), "last_seq": seq, "last_seen": seen[1] if seq else None,
-                "connected": not origin.gone}
+        return schema.tile(name=entry.name, robot=origin.robot,
+                           machine=entry.name.partition(":")[2] if origin.robot else entry.name, source=origin.source,
+                           state=state_of(entry), outcome=outcome,
+                           error=error.get("exc_type") or error.get("message") or None, active=active,
+                           rate=round(rate, 1), last_seq=seq, last_seen=seen[1] if seq else None,
+                           connected=not origin.gone)

@@ -28,6 +28,9 @@ if TYPE_CHECKING:
     from .hub import Hub, MachineEntry
 
 ANSWER_TIMEOUT = 5.0  # seconds a control waits for the publishing process's answer (then 504)
+# The fields of the publisher's frames read here, as their definitions (schema/messages.py) name them.
+_CONTROLLABLE, _CAN_START = schema.field_names("hello")
+_ANSWER_ID = schema.field_names("answer")[0]  # its first field: the control's id
 
 
 NOT_CONNECTED = "the publishing process of %r is not connected: its controls are unavailable"
@@ -67,11 +70,11 @@ class IngestLink:
 
     def hello(self, frame: dict) -> str | None:
         """The publisher says which of its machines take controls; returns what is wrong with the frame."""
-        names, can_start = frame.get("controllable"), frame.get("can_start", {})
+        names, can_start = frame.get(_CONTROLLABLE), frame.get(_CAN_START, {})
         if type(names) is not list or any(type(name) is not str for name in names):
-            return "hello.controllable must be a list of machine names"
+            return "hello.%s must be a list of machine names" % _CONTROLLABLE
         if type(can_start) is not dict:
-            return "hello.can_start must be an object"
+            return "hello.%s must be an object" % _CAN_START
         self.controllable = {name: can_start.get(name) is True for name in names}
         for name in self.fed:
             self._bind(self.hub.get(name))
@@ -79,9 +82,9 @@ class IngestLink:
 
     def answer(self, frame: dict) -> str | None:
         """The publisher's answer to a control; one nobody waits for any more (too late) is dropped."""
-        answer_id = frame.get("id")
+        answer_id = frame.get(_ANSWER_ID)
         if type(answer_id) is not int:
-            return "answer.id must be an integer"
+            return "answer.%s must be an integer" % _ANSWER_ID
         waiting = self._pending.get(answer_id)
         if waiting is not None and not waiting[1].done():
             waiting[1].set_result(frame)

@@ -1,8 +1,9 @@
 """The schema (fsm/observation/schema/) as the browser and the docs read it.
 
-``static/schema.js`` (its constants, and JSDoc typedefs of every event, frame and shape) and the
-field tables of ``docs/events.md`` are generated from the one definition in ``fsm.observation.schema``;
-``tests/unit/test_schema_export.py`` regenerates both and fails on any difference. After changing the
+``static/schema.js`` (its constants, and JSDoc typedefs of every event, frame and shape), the field
+tables of ``docs/events.md`` and the frame tables of ``docs/api.md`` are generated from the one
+definition in ``fsm.observation.schema``; ``tests/unit/test_schema_export.py`` regenerates them and
+fails on any difference. After changing the
 schema: ``python -m server.schema_export``.
 """
 
@@ -17,6 +18,10 @@ from fsm.observation import names, schema, vocabularies
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 JS_PATH = os.path.join(ROOT, "static", "schema.js")
 DOC_PATH = os.path.join(ROOT, "docs", "events.md")
+API_DOC_PATH = os.path.join(ROOT, "docs", "api.md")
+# The websocket frames docs/api.md lists, a table per websocket they travel on.
+SOCKETS = {"stream_frames": ("snapshot", "events", "missed", "pace"), "overview_frames": ("overview",),
+           "ingest_frames": ("hello", "control", "answer", "lease", "rejected")}
 _BLOCK = re.compile(r"(<!-- schema:(\w+) -->\n).*?(<!-- /schema -->)", re.S)
 
 
@@ -66,6 +71,9 @@ export const KINDS = Object.freeze(%(kinds)s);
 
 /** Where a served machine's events come from. */
 export const SOURCES = Object.freeze(%(sources)s);
+
+/** A fleet overview tile's states, in the order that needs a look first. */
+export const TILE_STATES = Object.freeze(%(tile_states)s);
 
 // Graph element ids: a path can hold any character; control characters and '%%' are
 // percent-escaped (one to one), as the server's SVG writes them.
@@ -127,7 +135,7 @@ export const TICK_KINDS = Object.freeze(%(tick_kinds)s);
 // (import one with /** @typedef {import("./schema.js").NAME} NAME */).
 
 %(typedefs)s""" % {"typedefs": typedefs(), "version": schema.VERSION, "kinds": json.dumps(list(schema.KINDS)),
-       "sources": json.dumps({s: s for s in schema.SOURCES}),
+       "sources": json.dumps({s: s for s in schema.SOURCES}), "tile_states": json.dumps(list(schema.TILE_STATES)),
        "escapes": json.dumps(escapes), "pattern": pattern,
        "s": schema.ID_PREFIXES["state"], "c": schema.ID_PREFIXES["container"], "o": schema.ID_PREFIXES["outcome"],
        "e": schema.ID_PREFIXES["edge"], "container_types": json.dumps(list(schema.CONTAINER_TYPES)),
@@ -155,13 +163,44 @@ def tables() -> dict[str, str]:
     return out
 
 
-def events_doc(text: str) -> str:
-    """docs/events.md with every ``<!-- schema:NAME -->`` block filled from the schema."""
-    generated = tables()
+def _cell(text: str) -> str:
+    return text.replace("|", "\\|")
 
+
+def _frames(names: tuple[str, ...]) -> str:
+    """A table of frames: each as its JSON object with its fields' types (``"name"?``: optional), who
+    sends it, and what it and its fields say."""
+    rows = ["| frame | from | meaning |", "|---|---|---|"]
+    for name in names:
+        message = schema.MESSAGES[name]
+        sample = ", ".join(['"type": "%s"' % name] + ['"%s"%s: %s' % (f.name, "" if f.required else "?", f.type.js)
+                                                     for f in message.fields])
+        said = " ".join([message.doc] + ["`%s`: %s." % (f.name, f.doc) for f in message.fields if f.doc])
+        rows.append("| `{%s}` | %s | %s |" % (_cell(sample), message.sender, _cell(said)))
+    return "\n".join(rows) + "\n"
+
+
+def api_tables() -> dict[str, str]:
+    """Every generated table of docs/api.md: the frames of each websocket, a snapshot's history, a tile."""
+    out = {name: _frames(names) for name, names in SOCKETS.items()}
+    out.update(history=_table(schema.HISTORY_FIELDS), tile=_table(schema.TILE_FIELDS))
+    return out
+
+
+def _filled(text: str, generated: dict[str, str]) -> str:
     def fill(match: re.Match) -> str:
         return match.group(1) + generated[match.group(2)] + match.group(3)
     return _BLOCK.sub(fill, text)
+
+
+def events_doc(text: str) -> str:
+    """docs/events.md with every ``<!-- schema:NAME -->`` block filled from the schema."""
+    return _filled(text, tables())
+
+
+def api_doc(text: str) -> str:
+    """docs/api.md with every ``<!-- schema:NAME -->`` block filled from the schema."""
+    return _filled(text, api_tables())
 
 
 def blocks(text: str) -> set[str]:
@@ -173,10 +212,11 @@ def main() -> None:
     js = javascript()
     with open(JS_PATH, "w", encoding="utf-8") as handle:
         handle.write(js)
-    with open(DOC_PATH, encoding="utf-8") as handle:
-        doc = events_doc(handle.read())
-    with open(DOC_PATH, "w", encoding="utf-8") as handle:
-        handle.write(doc)
+    for path, fill in ((DOC_PATH, events_doc), (API_DOC_PATH, api_doc)):
+        with open(path, encoding="utf-8") as handle:
+            doc = fill(handle.read())
+        with open(path, "w", encoding="utf-8") as handle:
+            handle.write(doc)
 
 
 if __name__ == "__main__":

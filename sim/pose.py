@@ -24,6 +24,8 @@ from typing import TYPE_CHECKING, Any, Callable
 import mujoco
 import numpy as np
 
+from fsm.observation import schema
+
 if TYPE_CHECKING:
     from .world import World
 
@@ -54,12 +56,12 @@ class PoseLayout:
         return np.round(qpos[self.index], DECIMALS) + 0.0
 
     def fields(self, values: np.ndarray) -> PoseFields:
-        """A sample as a pose event's fields."""
+        """A sample as a pose event's fields (made by the schema's ``fields_of.pose``)."""
         numbers = values.tolist()
         n = len(self.joints)
         joints = dict(zip(self.joints, numbers[:n]))
         bodies = {name: numbers[n + 7 * i: n + 7 * i + 7] for i, name in enumerate(self.bodies)}
-        return {"joints": joints, "bodies": bodies} if bodies else {"joints": joints}
+        return schema.fields_of.pose(joints, bodies or schema.ABSENT)
 
     def qpos(self, pose: PoseFields) -> np.ndarray:
         """The ``qpos`` a pose describes; what it leaves out keeps the model's initial value.

@@ -46,6 +46,7 @@ function render() {
 function connect() {
   const ws = new WebSocket(api.overviewUrl(), streamProtocols());
   ws.onmessage = (message) => {
+    /** @type {import("./schema.js").Frame} */
     const frame = JSON.parse(message.data);
     if (frame.type !== "overview") return;
     failures = 0;

@@ -4,6 +4,8 @@
 import { h } from "./dom.js";
 import { agoText, shortPath } from "./fleet_view.js";
 
+/** @typedef {import("./schema.js").Tile} Tile */
+
 const SOURCE_LABEL = { local: "this server", ingest: "publisher", replay: "replay" };
 
 export class FleetTiles {
@@ -13,7 +15,11 @@ export class FleetTiles {
     this.tiles = new Map(); // name -> {el, parts}
   }
 
-  /** Show exactly `tiles`, in their order; `now`: the server's clock now (for "last seen"). */
+  /**
+   * Show exactly `tiles`, in their order; `now`: the server's clock now (for "last seen").
+   * @param {Tile[]} tiles
+   * @param {number} now
+   */
   show(tiles, now) {
     const names = new Set(tiles.map((t) => t.name));
     for (const [name, tile] of this.tiles) {

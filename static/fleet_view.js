@@ -1,8 +1,12 @@
 // What the fleet overview shows of its tiles (server/overview.py): which ones, in which order, and
 // how each says when it was last seen. Pure functions of the tiles and the page's choices.
 
+import { TILE_STATES } from "./schema.js";
+
+/** @typedef {import("./schema.js").Tile} Tile */
+
 /** The states a tile can be in, in the order "by state" sorts them (what needs a look first). */
-export const STATES = ["failed", "gone", "running", "idle", "done"];
+export const STATES = TILE_STATES;
 
 const SORTS = {
   robot: (a, b) => compareText(a.robot ?? "", b.robot ?? "") || compareText(a.machine, b.machine),
@@ -19,6 +23,8 @@ function compareText(a, b) {
 /**
  * The tiles to show: those in `state` ("" for all) whose robot, machine or active state contains
  * `text` (case-insensitive), sorted by `sort` (robot, machine, state, seen, rate).
+ * @param {Tile[]} tiles
+ * @returns {Tile[]}
  */
 export function visibleTiles(tiles, { text = "", state = "", sort = "robot" } = {}) {
   const needle = text.trim().toLowerCase();
@@ -27,7 +33,7 @@ export function visibleTiles(tiles, { text = "", state = "", sort = "robot" } = 
   return shown.sort(SORTS[sort] || SORTS.robot);
 }
 
-/** How many tiles are in each state. */
+/** How many tiles are in each state. @param {Tile[]} tiles */
 export function countStates(tiles) {
   const counts = Object.fromEntries(STATES.map((s) => [s, 0]));
   for (const t of tiles) counts[t.state] += 1;

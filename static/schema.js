@@ -10,6 +10,9 @@ export const KINDS = Object.freeze(["structure", "start", "transition", "termina
 /** Where a served machine's events come from. */
 export const SOURCES = Object.freeze({"local": "local", "ingest": "ingest", "replay": "replay"});
 
+/** A fleet overview tile's states, in the order that needs a look first. */
+export const TILE_STATES = Object.freeze(["failed", "gone", "running", "idle", "done"]);
+
 // Graph element ids: a path can hold any character; control characters and '%' are
 // percent-escaped (one to one), as the server's SVG writes them.
 const ESCAPED = new Map(Object.entries({"\u0000": "%00", "\u0001": "%01", "\u0002": "%02", "\u0003": "%03", "\u0004": "%04", "\u0005": "%05", "\u0006": "%06", "\u0007": "%07", "\b": "%08", "\t": "%09", "\n": "%0A", "\u000b": "%0B", "\f": "%0C", "\r": "%0D", "\u000e": "%0E", "\u000f": "%0F", "\u0010": "%10", "\u0011": "%11", "\u0012": "%12", "\u0013": "%13", "\u0014": "%14", "\u0015": "%15", "\u0016": "%16", "\u0017": "%17", "\u0018": "%18", "\u0019": "%19", "\u001a": "%1A", "\u001b": "%1B", "\u001c": "%1C", "\u001d": "%1D", "\u001e": "%1E", "\u001f": "%1F", "%": "%25", "\u007f": "%7F", "\ufffe": "%uFFFE", "\uffff": "%uFFFF"}));
@@ -275,7 +278,7 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  * The machine's whole state: the first frame of a stream (unless it resumes), and again after missed (server to page).
  * @typedef {Object} SnapshotFrame
  * @property {"snapshot"} type
- * @property {MachineStatus} status the machine's status with its structure (below)
+ * @property {MachineStatus} status the machine's status with its structure (docs/events.md)
  * @property {number} last_seq the seq of the last event the status includes
  * @property {History} [history] a new connection's only: the current run's events up to last_seq, for the log (already in the status: not to be applied again)
  */
@@ -302,19 +305,19 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  */
 
 /**
- * The fleet overview's tiles (GET /api/overview's), at most once a second (server to page).
+ * The fleet overview's tiles (GET /api/overview's), at most twice a second, when a tile changed (server to page).
  * @typedef {Object} OverviewFrame
  * @property {"overview"} type
  * @property {number} now the server's clock
- * @property {Array<Object<string, *>>} tiles as GET /api/overview
+ * @property {Array<Tile>} tiles as GET /api/overview
  */
 
 /**
- * Which of its machines take controls (and may be started again): first on each connection, again when a machine is attached (publisher to server).
+ * Which of its machines take controls (and may be started again): first on each connection, again when a machine is attached; each replaces the last (publisher to server).
  * @typedef {Object} HelloFrame
  * @property {"hello"} type
  * @property {Array<string>} controllable machine names
- * @property {Object<string, boolean>} can_start {name: bool}
+ * @property {Object<string, boolean>} can_start {name: whether it may be started again}
  */
 
 /**
@@ -323,8 +326,8 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  * @property {"control"} type
  * @property {number} id its answer carries it
  * @property {string} machine
- * @property {string} action
- * @property {Object<string, *>} params
+ * @property {string} action what to do (below)
+ * @property {Object<string, *>} params the action's (below)
  * @property {string} client who asked
  */
 
@@ -340,13 +343,13 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  */
 
 /**
- * The operator lease of one of its machines was taken, released or lapsed (server to publisher).
+ * The operator lease of one of its machines was taken, released or lapsed; sent again when the publisher reconnects (server to publisher).
  * @typedef {Object} LeaseFrame
  * @property {"lease"} type
  * @property {string} machine
  * @property {boolean} held
  * @property {number} after seconds
- * @property {("pause"|"preempt"|"none")} action what the publisher does itself when its link is gone that long
+ * @property {("pause"|"preempt"|"none")} action while it is held, what the publisher does itself when its link is gone that long
  */
 
 /**
@@ -473,6 +476,23 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  * @property {Array<StructureNode>} [children] a container's: nodes, in add order
  * @property {(string|null)} [default_outcome] a container's: a Concurrence's
  * @property {Object<string, Object<string, string>>} [outcome_map] a container's: a Concurrence's {container outcome: {child: outcome}}
+ */
+
+/**
+ * A fleet overview tile.
+ * @typedef {Object} Tile
+ * @property {string} name the dashboard's name of the machine (a robot's: robot:machine)
+ * @property {(string|null)} robot the robot publishing it on Zenoh (null for the others)
+ * @property {string} machine its name on its robot (its name, for the others)
+ * @property {("local"|"ingest"|"replay")} source where its events come from (GET /api/machines' source)
+ * @property {("failed"|"gone"|"running"|"idle"|"done")} state failed: its run ended on an error; gone: its process went away while it ran or idled; done: it reached an outcome
+ * @property {(string|null)} outcome the outcome its run reached
+ * @property {(string|null)} error the exception type of a failed run
+ * @property {Array<string>} active the full paths of its active states (leaves)
+ * @property {number} rate events per second over the last 5 s, as the server received them
+ * @property {number} last_seq its newest event's
+ * @property {(number|null)} last_seen when the server saw its newest event (Unix time, the server's clock; null before any)
+ * @property {boolean} connected false when the process that publishes it has gone away
  */
 
 /**

@@ -15,6 +15,9 @@ from .controls import Controls, Refused
 
 DEADMAN_ACTIONS = schema.DEADMAN_ACTIONS  # what a deadman does when its lease lapses
 MAX_AFTER = 86400.0  # a deadman's delay longer than a day is not one (and would overflow a timer's wait)
+# The fields of the server's frames read here, as their definitions (schema/messages.py) name them.
+_ID, _MACHINE, _ACTION, _PARAMS, _CLIENT = schema.field_names("control")
+_LEASE_MACHINE, _HELD, _AFTER, _DEADMAN_ACTION = schema.field_names("lease")
 
 
 class Params:
@@ -22,37 +25,37 @@ class Params:
 
     def __init__(self, params: Any) -> None:
         if type(params) is not dict:
-            raise Refused(422, "params must be an object")
+            raise Refused(422, "%s must be an object" % _PARAMS)
         self.params = params
 
     def text(self, key: str) -> str:
         value = self.params.get(key)
         if type(value) is not str:
-            raise Refused(422, "params.%s must be a string" % key)
+            raise Refused(422, "%s.%s must be a string" % (_PARAMS, key))
         return value
 
     def optional_text(self, key: str) -> str | None:
         value = self.params.get(key)
         if value is not None and type(value) is not str:
-            raise Refused(422, "params.%s must be a string or null" % key)
+            raise Refused(422, "%s.%s must be a string or null" % (_PARAMS, key))
         return value
 
     def texts(self, key: str) -> list[str]:
         value = self.params.get(key, [])
         if type(value) is not list or any(type(item) is not str for item in value):
-            raise Refused(422, "params.%s must be a list of strings" % key)
+            raise Refused(422, "%s.%s must be a list of strings" % (_PARAMS, key))
         return value
 
     def object(self, key: str) -> dict:
         value = self.params.get(key) or {}
         if type(value) is not dict:
-            raise Refused(422, "params.%s must be an object" % key)
+            raise Refused(422, "%s.%s must be an object" % (_PARAMS, key))
         return value
 
     def items(self, key: str) -> list:
         value = self.params.get(key, [])
         if type(value) is not list:
-            raise Refused(422, "params.%s must be a list" % key)
+            raise Refused(422, "%s.%s must be a list" % (_PARAMS, key))
         return value
 
 
@@ -83,20 +86,20 @@ CONTROLS: dict[str, Callable[[Controls, Params, str], dict]] = {
 def answer(handles: dict[str, Controls], frame: dict) -> tuple[str, dict] | None:
     """The answer to a control frame, with the machine it named (None: a frame with no id to answer).
     Never raises: what the request or the machine refused is the answer's 4xx and ``detail``."""
-    answer_id = frame.get("id")
+    answer_id = frame.get(_ID)
     if type(answer_id) is not int:
         return None
-    machine, action, client = frame.get("machine"), frame.get("action"), frame.get("client", "")
+    machine, action, client = frame.get(_MACHINE), frame.get(_ACTION), frame.get(_CLIENT, "")
     handle = handles.get(machine) if type(machine) is str else None
     try:
         if handle is None:
             raise Refused(404, "no machine named %r publishes from this process" % (machine,))
         if type(client) is not str:
-            raise Refused(422, "client must be a string")
+            raise Refused(422, "%s must be a string" % _CLIENT)
         control = CONTROLS.get(action) if type(action) is str else None
         if control is None:
             raise Refused(422, "unknown action %r (one of %s)" % (action, ", ".join(CONTROLS)))
-        fields = control(handle, Params(frame.get("params", {})), client)
+        fields = control(handle, Params(frame.get(_PARAMS, {})), client)
     except Refused as err:
         fields = {"status": err.status, "detail": err.message}
     except Exception as exc:  # the machine's own code failed: say so, keep publishing
@@ -107,7 +110,8 @@ def answer(handles: dict[str, Controls], frame: dict) -> tuple[str, dict] | None
 def lease_of(frame: dict) -> tuple[str, tuple[float, str] | None] | None:
     """What a ``lease`` frame says of its machine: (after, action) of the deadman to arm while the
     lease is held, or None to disarm it (released, or action none); None for a malformed frame."""
-    machine, held, after, action = frame.get("machine"), frame.get("held"), frame.get("after"), frame.get("action")
+    machine, held, after, action = (frame.get(_LEASE_MACHINE), frame.get(_HELD), frame.get(_AFTER),
+                                    frame.get(_DEADMAN_ACTION))
     if type(machine) is not str or type(held) is not bool or action not in DEADMAN_ACTIONS:
         return None
     if type(after) not in (int, float) or not 0 <= after <= MAX_AFTER:  # NaN fails the comparison too

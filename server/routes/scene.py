@@ -11,21 +11,22 @@ from typing import Any, Callable
 from fastapi import APIRouter, HTTPException, Request
 from fastapi.concurrency import run_in_threadpool
 
-from fsm.observation.schema import event, validate
+from fsm.observation.schema import KINDS, event, validate
 
 from .. import models
 from .deps import AUTH, ERRORS
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["control"])
 
-POSE_FIELDS = ("joints", "bodies")
+POSE_FIELDS = tuple(f.name for f in KINDS["pose"].fields)
 
 
 def pose_problem(pose: dict[str, Any]) -> str | None:
     """What is wrong with ``pose`` as a pose event's fields, in the schema's words; None when it fits."""
     extra = sorted(set(pose) - set(POSE_FIELDS))
     if extra:
-        return "pose may hold only joints and bodies, not %s" % ", ".join(repr(k[:50]) for k in extra[:5])
+        return "pose may hold only %s, not %s" % (" and ".join(POSE_FIELDS),
+                                                  ", ".join(repr(k[:50]) for k in extra[:5]))
     return validate(event(0, 0.0, None, "scene", "pose", "/", pose))
 
 

@@ -159,6 +159,14 @@ def test_a_malformed_answer_closes_the_publisher_with_1007(fake_publisher):
     assert (fake_publisher.close_code, fake_publisher.close_reason) == (1007, "answer.id must be an integer")
 
 
+def test_a_hello_whose_machines_are_not_names_closes_the_publisher_with_1007(fake_publisher):
+    fake_publisher.send(json.dumps({"type": "hello", "controllable": "m", "can_start": {}}))
+    with pytest.raises(Exception):
+        fake_publisher.recv(timeout=5)
+    assert (fake_publisher.close_code, fake_publisher.close_reason) == (
+        1007, "hello.controllable must be a list of machine names")
+
+
 def test_a_control_frame_with_params_of_the_wrong_type_is_answered_422_and_one_without_id_ignored():
     sm = fsm.StateMachine(outcomes=["done"])
     with sm:

@@ -13,6 +13,7 @@ from server_support import client
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
+from fsm.observation import schema
 from server.testing.polling import wait_for
 
 
@@ -80,6 +81,15 @@ def test_the_overview_stream_sends_the_tiles(live_server):
     with connect(url, open_timeout=5) as ws:
         frame = json.loads(ws.recv(timeout=5))
     assert frame["type"] == "overview" and [t["name"] for t in frame["tiles"]] == ["r3:patrol"]
+
+
+def test_the_overview_frame_and_its_tiles_fit_the_schema(live_server):
+    ingest(live_server, "r4:sort", started("r4:sort"))
+    url = "ws://127.0.0.1:%d/api/overview/stream?token=%s" % (live_server.port, live_server.token)
+    with connect(url, open_timeout=5) as ws:
+        frame = json.loads(ws.recv(timeout=5))
+    assert schema.frame_problem(frame) is None
+    assert [set(t) for t in frame["tiles"]] == [{f.name for f in schema.TILE_FIELDS}]
 
 
 def test_the_overview_stream_refuses_a_client_without_the_token(live_server):

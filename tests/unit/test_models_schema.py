@@ -26,6 +26,7 @@ PAIRS = [
     (models.BreakpointSpec, schema.BREAKPOINT_FIELDS, set(), set()),
     (models.StructureNode, schema.NODE.shape, set(), set()),
     (models.Transition, schema.TRANSITION_FIELDS, set(), set()),
+    (models.Tile, schema.TILE_FIELDS, set(), set()),
 ]
 
 
@@ -83,3 +84,5 @@ def test_a_rest_model_allows_null_where_the_schema_does_and_holds_the_same_kind_
 def test_the_models_vocabularies_are_the_schemas():
     assert typing.get_args(models.MachineInfo.model_fields["source"].annotation) == schema.SOURCES
     assert typing.get_args(control_models.Deadman.model_fields["action"].annotation) == schema.DEADMAN_ACTIONS
+    assert typing.get_args(models.Tile.model_fields["source"].annotation) == schema.SOURCES
+    assert typing.get_args(models.Tile.model_fields["state"].annotation) == schema.TILE_STATES

@@ -114,6 +114,21 @@ def _names(fields):
     return {f.name for f in fields}
 
 
+def test_a_kinds_own_fields_are_its_events_without_the_envelope():
+    joints, bodies = {"j1": 0.5}, {"cube": [0.4, 0.1, 0.4, 1.0, 0.0, 0.0, 0.0]}
+    event = schema.build.pose(1, 0.0, None, "m", "/SM_ROOT", joints, bodies)
+    envelope = {f.name for f in schema.ENVELOPE}
+    assert schema.fields_of.pose(joints, bodies) == {k: v for k, v in event.items() if k not in envelope}
+    assert schema.fields_of.pose(joints) == {"joints": joints}
+
+
+@pytest.mark.parametrize("name", list(schema.MESSAGES))
+def test_a_frames_field_names_are_in_the_order_its_maker_takes_them(name):
+    made = getattr(schema.frame, name)(*schema.field_names(name))
+    assert list(made) == ["type", *schema.field_names(name)]
+    assert [made[field] for field in schema.field_names(name)] == list(schema.field_names(name))
+
+
 def test_the_reducers_status_holds_the_fields_of_the_schemas_status_and_no_other():
     from fsm.observation.status import Status
 

@@ -5,6 +5,7 @@ a field's name is written once, here, and an event is made as one dict literal: 
 path pays no more than for a hand-written one. ``build.transition(seq, t, run, machine, path, from_,
 outcome, to, active)``: the envelope's values, then the kind's fields in their order, a field that is
 a Python keyword with a trailing ``_``; an optional field left out (``ABSENT``) is not in the event.
+``fields_of.pose(joints, bodies)``: the same kind's own fields alone.
 """
 
 from __future__ import annotations
@@ -102,6 +103,11 @@ def _envelope(kind: str) -> tuple[tuple[str, str], ...]:
 
 # ``build.KIND(...)``: the one way an event of each kind is made.
 build = SimpleNamespace(**{name: maker(name, _envelope(name), k.fields, k.doc) for name, k in KINDS.items()})
+
+# ``fields_of.KIND(...)``: a kind's own fields without the envelope, for what handles them before any
+# reporter stamps them (the simulator's pose sampler, POST /api/scene/pose): made as ``build`` makes events.
+fields_of = SimpleNamespace(**{name: maker(name, (), k.fields, "A %s event's own fields: %s" % (name, k.doc))
+                               for name, k in KINDS.items()})
 
 
 def event(seq: int, t: float, run: str | None, machine: str, kind: str, path: str,

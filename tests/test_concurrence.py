@@ -76,6 +76,19 @@ def test_child_exception_raises_invalid_state_error_from_execute(logs):
 
 
 @pytest.mark.timeout(5)
+def test_child_exception_logs_the_child_error_with_its_traceback_then_the_concurrence_error(logs):
+    def bad(ud):
+        raise ValueError("boom")
+    cc = concurrence(["d"], "d", [("BOOM", Out(bad))])
+    with pytest.raises(smach.InvalidStateError):
+        cc.execute()
+    child_error, concurrence_error = logs.error
+    assert child_error.startswith("InvalidStateError: Could not execute child state 'BOOM': Traceback (most recent call last):")
+    assert child_error.endswith("ValueError: boom\n")
+    assert concurrence_error == "InvalidStateError: A concurrent state raised an exception during execution."
+
+
+@pytest.mark.timeout(5)
 def test_child_returning_none_ends_the_concurrence_with_an_error_instead_of_hanging(logs):
     cc = concurrence(["d"], "d", [("OK", Out("done")), ("NONE", Out(None, outcomes=["done"]))])
     with pytest.raises(smach.InvalidStateError) as info:

@@ -172,6 +172,8 @@ class Concurrence(Container):
                     outcome = state.execute(Remapper(self.userdata, state.get_registered_input_keys(),
                                                      state.get_registered_output_keys(), self._remappings[label]))
                 except BaseException as exc:
+                    # As SMACH's _state_runner: the child's error logs itself, traceback and all.
+                    InvalidStateError(("Could not execute child state '%s': " % label) + traceback.format_exc())
                     self._fail(label, exc)
                     return
             dbg = self._debugger

@@ -219,3 +219,12 @@ def test_shutdown_check_stops_the_concurrence_waiting_for_its_children(logs):
         assert not cc.is_running()
     finally:
         release.set()
+
+
+def test_a_run_logs_smachs_debug_lines_when_it_stops_waiting_and_while_it_picks_the_mapped_outcome(logs):
+    cc = _two("done", "done", outcome_map={"x": {"A": "done", "B": "done"}, "y": {"A": "done"}})
+    assert cc.execute() == "x"
+    assert logs.debug == ["SMACH Concurrence preempting running states.",
+                          "SMACH Concurrence determining contained state outcomes.",
+                          "Terminating concurrent split with mapped outcome.",
+                          "Skipping mapped outcome 'y' with fewer constraints."]

@@ -15,7 +15,8 @@ import fsm
 import fsm.core.log
 import pytest
 
-from parity_support import Parity
+pytest.register_assert_rewrite("parity_support")
+from parity_support import Parity  # noqa: E402
 
 ORIGINAL_SRC = Path(__file__).resolve().parents[2].parent / "shared/reference/executive_smach/noetic/smach/src"
 

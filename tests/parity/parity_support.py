@@ -3,6 +3,7 @@ the normalisation of what legitimately differs between the original SMACH and fs
 
 import re
 import threading
+from types import SimpleNamespace
 from typing import Any, Callable
 
 import fsm
@@ -58,7 +59,7 @@ def outcome_of(fn: Callable[[], Any]) -> tuple:
 _ADDRESS = re.compile(r" at 0x[0-9a-fA-F]+")
 _MODULE = re.compile(r"\b(?:smach|fsm(?:\.core)?)\.(state|user_data|container|state_machine|concurrence|iterator|"
                      r"sequence|util|exceptions)\.")
-_TRACEBACK = re.compile(r"Traceback \(most recent call last\):\n(?:  .*\n)+")
+_TRACEBACK = re.compile(r"Traceback \(most recent call last\):\n(?:  .*\n|\n)+")
 
 
 def normalised(value: Any) -> Any:
@@ -102,5 +103,68 @@ class Parity:
         """Asserts that both implementations give the same result, log the same lines and end no
         thread differently; returns fsm's."""
         theirs, ours = self.run(scenario)
-        assert ours == theirs
+        assert ours["result"] == theirs["result"]
+        assert ours["logs"] == theirs["logs"]
+        assert ours["thread_errors"] == theirs["thread_errors"]
         return ours
+
+
+def kit(sm: Any) -> Any:
+    """Small states and builders made of one implementation's classes (``sm``), alike on both sides."""
+
+    class Out(sm.State):
+        """Returns ``result``, or ``result(ud)`` when it is callable (its outcomes then default to ['done'])."""
+
+        def __init__(self, result: Any = "done", outcomes: Any = None, input_keys: list = [],
+                     output_keys: list = [], io_keys: list = []) -> None:
+            if outcomes is None:
+                outcomes = ["done"] if callable(result) else [result]
+            sm.State.__init__(self, outcomes, input_keys, output_keys, io_keys)
+            self.result = result
+            self.saw_preempt: list[bool] = []
+
+        def execute(self, ud: Any) -> Any:
+            self.saw_preempt.append(self.preempt_requested())
+            return self.result(ud) if callable(self.result) else self.result
+
+    class WaitForPreempt(sm.State):
+        """Blocks until preempted (``started`` is set once it runs), services the preempt if told
+        to, and returns ``result``; 'timeout' after 5 s without a preempt."""
+
+        def __init__(self, outcomes: Any = ("preempted",), service: bool = True, result: str = "preempted") -> None:
+            sm.State.__init__(self, list(outcomes))
+            self.started = threading.Event()
+            self.preempted = threading.Event()
+            self.service = service
+            self.result = result
+
+        def request_preempt(self) -> None:
+            sm.State.request_preempt(self)
+            self.preempted.set()
+
+        def execute(self, ud: Any) -> str:
+            self.started.set()
+            if not self.preempted.wait(5):
+                return "timeout"
+            self.preempted.clear()
+            if self.service:
+                self.service_preempt()
+            return self.result
+
+    def machine(outcomes: list, children: list, **kwargs: Any) -> Any:
+        """A StateMachine of ``(label, state, transitions[, remapping])`` tuples."""
+        built = sm.StateMachine(outcomes=outcomes, **kwargs)
+        with built:
+            for child in children:
+                sm.StateMachine.add(*child)
+        return built
+
+    def concurrence(outcomes: list, default_outcome: str, children: list, **kwargs: Any) -> Any:
+        """A Concurrence of ``(label, state[, remapping])`` tuples."""
+        built = sm.Concurrence(outcomes=outcomes, default_outcome=default_outcome, **kwargs)
+        with built:
+            for child in children:
+                sm.Concurrence.add(*child)
+        return built
+
+    return SimpleNamespace(Out=Out, WaitForPreempt=WaitForPreempt, machine=machine, concurrence=concurrence)

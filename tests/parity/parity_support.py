@@ -59,17 +59,17 @@ def outcome_of(fn: Callable[[], Any]) -> tuple:
 _ADDRESS = re.compile(r" at 0x[0-9a-fA-F]+")
 _MODULE = re.compile(r"\b(?:smach|fsm(?:\.core)?)\.(state|user_data|container|state_machine|concurrence|iterator|"
                      r"sequence|util|exceptions)\.")
-_TRACEBACK = re.compile(r"Traceback \(most recent call last\):\n(?:  .*\n|\n)+")
+_FRAMES = re.compile(r"^(?:  .*\n)+", re.MULTILINE)
 
 
 def normalised(value: Any) -> Any:
     """``value`` with what legitimately differs between the two made equal: object addresses, the
-    module a core class lives in (``smach.state`` against ``fsm.core.state``) and a traceback's
-    frames (the last line, the exception, is kept)."""
+    module a core class lives in (``smach.state`` against ``fsm.core.state``) and the frames of a
+    traceback (each run of indented lines becomes one; the rest, the exception lines, is kept)."""
     if isinstance(value, str):
         value = _ADDRESS.sub(" at 0x…", value)
         value = _MODULE.sub(r"smach.\1.", value)
-        return _TRACEBACK.sub("Traceback (most recent call last):\n  …\n", value)
+        return _FRAMES.sub("  …\n", value)
     if isinstance(value, (list, tuple)):
         return type(value)(normalised(v) for v in value)
     if isinstance(value, dict):

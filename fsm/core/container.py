@@ -234,7 +234,7 @@ class Container(State):
             return False
         if exc_type not in (InvalidStateError, InvalidTransitionError):
             log.logerr("Error raised during SMACH container construction: \n"
-                       + "".join(traceback.format_exception(exc_type, exc_val, exc_tb)))
+                       + "\n".join(traceback.format_exception(exc_type, exc_val, exc_tb)))
         # Fixed against SMACH: the failed container is closed, so the stack and the global lock
         # are not left held; the exception still propagates.
         if self in Container._construction_stack:

@@ -114,6 +114,7 @@ class Iterator(Container):
         try:
             return self._state.execute(self.userdata)
         except InvalidUserCodeError:
+            log.logerr("Could not execute Iterator state '%s'" % self._state_label)
             raise
         except Exception as exc:
             raise introspection.carry_reported(InvalidUserCodeError(
@@ -142,7 +143,7 @@ class Iterator(Container):
         if len(initial_states) > 1:
             log.logwarn("Attempting to set initial state to include more than one state, but the Iterator container can only have one initial state. Taking the first one.")
         if initial_states and initial_states[0] != self._state_label:
-            log.logwarn("Attempting to set initial state of Iterator to '%s', but its only state is '%s'."
+            log.logwarn("Attempting to set state '%s' as initial state in Iterator container. The only available state is '%s'."
                         % (initial_states[0], self._state_label))
             raise KeyError()
         if userdata is not None:

@@ -215,12 +215,13 @@ class Container(State):
         raise InvalidStateError("Attempting to access the currently opened container, but no container is opened.")
 
     @contextmanager
-    def opened(self, **kwargs: Any) -> TypingIterator[None]:
+    def opened(self, **kwargs: Any) -> TypingIterator["Container"]:
+        """``with container.opened() as c:`` opens it for construction (binding it, unlike ``with container``)."""
         self.open()
         prev = Container._context_kwargs
         Container._context_kwargs = kwargs
         try:
-            yield
+            yield self
         finally:
             Container._context_kwargs = prev
             self.close()

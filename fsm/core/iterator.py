@@ -157,7 +157,9 @@ class Iterator(Container):
 
     def get_internal_edges(self) -> list:
         edges: list = [[o, self._state_label, self._state_label] for o in self._loop_outcomes]
-        edges += [(o, self._state_label, self._final_outcome_map.get(o)) for o in self._break_outcomes]
+        for o in self._break_outcomes:  # as SMACH: a break that keeps its own name falls through (None)
+            mapped = self._final_outcome_map.get(o, o)
+            edges.append((o, self._state_label, None if mapped == o else mapped))
         return edges
 
     def _introspection_info(self) -> dict:

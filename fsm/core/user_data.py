@@ -33,8 +33,14 @@ class UserData:
         if dirty is not None:
             dirty.add(name)
 
+    def __setitem__(self, key: str, value: Any) -> None:
+        """Any key, one with a leading underscore too (as SMACH's: only attribute syntax keeps those for the object)."""
+        self._data[key] = value
+        dirty = self._dirty
+        if dirty is not None:
+            dirty.add(key)
+
     __getitem__ = __getattr__
-    __setitem__ = __setattr__
 
     def keys(self) -> list[str]:
         return list(self._data.keys())

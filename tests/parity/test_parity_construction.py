@@ -167,3 +167,13 @@ def test_a_sequence_whose_state_lacks_the_connector_outcome_logs_that_constructi
         return outcome_of(seq.execute)
     same = parity.same(scenario)
     assert same["result"] == ("returned", "done")
+
+
+def test_opened_yields_the_container(parity):
+    def scenario(side):
+        sm = side.sm
+        built = sm.StateMachine(outcomes=["done"])
+        with built.opened() as bound:
+            sm.StateMachine.add("A", kit(sm).Out(), {})
+        return bound is built, built.is_opened(), outcome_of(built.execute)
+    assert parity.same(scenario)["result"] == (True, False, ("returned", "done"))

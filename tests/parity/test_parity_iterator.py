@@ -128,3 +128,16 @@ def test_iterator_set_initial_state(parity):
                                      "container can only have one initial state. Taking the first one.")] + theirs["logs"]
     assert theirs["logs"] == [("warn", "Attempting to set state 'OTHER' as initial state in Iterator container. The "
                                        "only available state is 'BODY'.")]
+
+
+def test_an_iterators_internal_edges(parity):
+    """A break outcome mapped to itself, like one not mapped, falls through: its edge leads to None."""
+    def scenario(side):
+        sm = side.sm
+        it = sm.Iterator(outcomes=["done", "stop"], input_keys=[], output_keys=[], it=[1], exhausted_outcome="done")
+        with it:
+            sm.Iterator.set_contained_state("B", kit(sm).Out("next", outcomes=["next", "stop", "halt", "odd"]),
+                                            loop_outcomes=["next"], final_outcome_map={"stop": "stop", "halt": "done"})
+        return sorted(map(str, it.get_internal_edges()))
+    assert parity.same(scenario)["result"] == ["('halt', 'B', 'done')", "('odd', 'B', None)", "('stop', 'B', None)",
+                                               "['next', 'B', 'B']"]

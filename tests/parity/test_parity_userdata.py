@@ -199,3 +199,50 @@ def test_a_missing_key_read_by_a_state_fails_with_the_same_traceback_text(parity
     same = parity.same(scenario)
     assert same["result"][2].endswith("KeyError: 'k'\n\nDuring handling of the above exception, another exception "
                                       "occurred:\n\nTraceback (most recent call last):\n  …\nKeyError\n")
+
+
+def test_cb_interface_keeps_its_outcomes_in_the_order_given(parity):
+    def scenario(side):
+        @side.sm.cb_interface(outcomes=["z", "a", "m"], input_keys=["i"], output_keys=["o"])
+        def cb(ud):
+            return "z"
+        return cb.get_registered_outcomes(), cb.get_registered_input_keys(), cb.get_registered_output_keys()
+    assert parity.same(scenario)["result"] == (("z", "a", "m"), ("i",), ("o",))
+
+
+def test_cbinterface_io_keys_deliberate_fix(parity):
+    """Fixed in fsm (fsm/core/util.py says so; not in README's table, listed in the parity report):
+    the original's CBInterface drops its io_keys (a set union whose result is thrown away)."""
+    def scenario(side):
+        cb = side.sm.CBInterface(lambda ud: "x", outcomes=["x"], io_keys=["io"])
+        return cb.get_registered_input_keys(), cb.get_registered_output_keys()
+    theirs, ours = parity.run(scenario)
+    assert theirs["result"] == ((), ())
+    assert ours["result"] == (("io",), ("io",))
+
+
+def test_an_item_key_with_a_leading_underscore_is_stored_as_a_key(parity):
+    def scenario(side):
+        ud = side.sm.UserData()
+        ud["_x"] = 1
+        other = side.sm.UserData()
+        other.update(ud)
+        return ud.keys(), other.keys(), outcome_of(lambda: ud["_x"])[:2]
+    assert parity.same(scenario)["result"] == (["_x"], ["_x"], ("raised", "AttributeError"))
+
+
+def test_printing_userdata_or_a_const_undocumented_difference(parity):
+    """Not in README's table (listed in the parity report): fsm prints a UserData as its dict and a
+    Const as the value it wraps; the original prints both as objects."""
+    def scenario(side):
+        class Thing:
+            def __str__(self):
+                return "thing"
+        ud = side.sm.UserData()
+        ud.a = 1
+        ud.thing = Thing()
+        return str(ud), str(side.sm.Remapper(ud, ["thing"], [], {}).thing)
+    theirs, ours = parity.run(scenario)
+    assert theirs["result"] == ("<smach.user_data.UserData object at 0x…>", "<smach.user_data.Const object at 0x…>")
+    assert ours["result"][1] == "thing"
+    assert ours["result"][0].startswith("{'a': 1, 'thing': <")

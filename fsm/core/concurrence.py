@@ -121,14 +121,14 @@ class Concurrence(Container):
         log.info_quiet("Concurrent Outcomes: " + str(self._child_outcomes))
         outcome = self._default_outcome
         best = 0
-        log.logdebug("SMACH Concurrence determining contained state outcomes.")
+        log.debug_quiet("SMACH Concurrence determining contained state outcomes.")
         for container_outcome, needed in self._outcome_map.items():
             if all(self._child_outcomes.get(label) == o for label, o in needed.items()):
                 if len(needed) > best:
-                    log.logdebug("Terminating concurrent split with mapped outcome.")
+                    log.debug_quiet("Terminating concurrent split with mapped outcome.")
                     outcome, best = container_outcome, len(needed)
                 else:
-                    log.logdebug("Skipping mapped outcome '%s' with fewer constraints." % container_outcome)
+                    log.debug_quiet("Skipping mapped outcome '%s' with fewer constraints." % container_outcome)
         if self._outcome_cb:
             try:
                 cb_outcome = self._outcome_cb(copy.copy(self._child_outcomes))
@@ -243,11 +243,20 @@ class Concurrence(Container):
             self._preempt_requested = True
             self._report("preempt", {"phase": "requested"})
             if self._is_running:
-                self._stop_waiting()
+                rep = self._reporter  # the line is this Concurrence's, whichever thread asked
+                prev = introspection.enter(rep, self._path) if rep is not None else introspection.NOT_ENTERED
+                try:
+                    self._stop_waiting()
+                finally:
+                    introspection.leave(prev)
                 self._preempt_unfinished()
 
     def get_children(self) -> dict:
         return self._states
+
+    def __getitem__(self, key: str) -> State:
+        """As SMACH's: an unknown label is a KeyError naming it, with no log line."""
+        return self._states[key]
 
     def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
         """Every child is initial; fixed against SMACH (a TypeError on Python 3): merges the userdata."""

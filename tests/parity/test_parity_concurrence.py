@@ -209,3 +209,13 @@ def test_callbacks_of_a_concurrence_get_the_active_children(parity):
         return outcome_of(cc.execute), calls
     assert parity.same(scenario)["result"] == (("returned", "d"), [
         ("start", ["A"]), ("transition", ["A"]), ("transition", []), ("termination", ["A"], "d")])
+
+
+def test_getting_an_unknown_child_of_a_concurrence_raises_a_key_error_naming_it(parity):
+    def scenario(side):
+        k = kit(side.sm)
+        cc = k.concurrence(["d"], "d", [("A", k.Out())])
+        return outcome_of(lambda: cc["NOPE"]), type(cc["A"]).__name__
+    same = parity.same(scenario)
+    assert same["result"] == (("raised", "KeyError", "'NOPE'"), "Out")
+    assert same["logs"] == []

@@ -219,3 +219,27 @@ def test_getting_an_unknown_child_of_a_concurrence_raises_a_key_error_naming_it(
     same = parity.same(scenario)
     assert same["result"] == (("raised", "KeyError", "'NOPE'"), "Out")
     assert same["logs"] == []
+
+
+def test_a_raising_child_termination_cb_documented_fix(parity):
+    """[bug] documented (README's table): in the original the callback's InvalidUserCodeError ends
+    the child's thread and the run goes on (here to the default outcome, once the other child ends);
+    fsm preempts the unfinished children and the Concurrence raises that error."""
+    def scenario(side):
+        k = kit(side.sm)
+        calls = []
+
+        def cb(outcomes):
+            calls.append(dict(outcomes))
+            if len(calls) == 1:
+                raise RuntimeError("cb exploded")
+            return False
+        return outcome_of(two(side, "done", "done", child_termination_cb=cb).execute)[:2], calls[:1]
+    theirs, ours = parity.run(scenario)
+    assert theirs["result"] == (("returned", "d"), [{"A": "done", "B": None}])
+    assert [name for name, message in theirs["thread_errors"]] == ["InvalidUserCodeError"]
+    assert ours["result"] == (("raised", "InvalidUserCodeError"), [{"A": "done", "B": None}])
+    assert ours["thread_errors"] == []
+    first_error = [[message for level, message in side["logs"] if level == "error"][0] for side in (theirs, ours)]
+    assert first_error[1] == first_error[0]
+    assert first_error[0].startswith("InvalidUserCodeError: Could not execute child termination callback: Traceback")

@@ -126,6 +126,7 @@ def callbacks_scenario(side):
 
     def record(kind):
         def cb(ud, *args):
+            sm.loginfo("%s callback" % kind)  # so that the log shows when each ran
             calls.append((kind, args, sub.get_active_states(), sorted(ud.keys()), "x" in parent.userdata))
         return cb
     sub = k.machine(["done"], [("A", k.Out("go"), {"go": "B"}), ("B", k.Out(lambda ud: setattr(ud, "x", 1) or "stop",
@@ -140,6 +141,12 @@ def callbacks_scenario(side):
 
 def test_callbacks_get_their_arguments_in_order_at_the_documented_moments(parity):
     same = parity.same(callbacks_scenario)
+    assert [message for level, message in same["logs"] if level == "info"] == [
+        "State machine starting in initial state 'SUB' with userdata: \n\t[]",
+        "State machine starting in initial state 'A' with userdata: \n\t[]", "start callback",
+        "State machine transitioning 'A':'go'-->'B'", "transition callback",
+        "State machine terminating 'B':'stop':'done'", "termination callback",
+        "State machine terminating 'SUB':'done':'done'"]
     assert same["result"] == (("returned", "done"), [
         ("start", (["A"], "extra"), ["A"], [], False),
         ("transition", (["B"], "extra"), ["B"], [], False),
@@ -215,3 +222,46 @@ def test_a_state_machine_can_be_executed_again_after_an_error(parity):
         fail[0] = False
         return first[:2], outcome_of(built.execute)
     assert parity.same(scenario)["result"] == (("raised", "InvalidUserCodeError"), ("returned", "done"))
+
+
+def test_an_outcome_bound_to_nothing_raises_and_one_bound_to_an_unknown_target_fails_the_check(parity):
+    def scenario(side):
+        k = kit(side.sm)
+        unbound = k.machine(["done"], [("A", k.Out("go"), {"go": "done"})])
+        del unbound._transitions["A"]["go"]
+        nowhere = k.machine(["done"], [("A", k.Out("go"), {"go": "done"})])
+        nowhere._transitions["A"]["go"] = "elsewhere"
+        return outcome_of(unbound.execute), outcome_of(nowhere.execute)
+    assert parity.same(scenario)["result"] == (
+        ("raised", "InvalidTransitionError", "Outcome 'go' of state 'A' is not bound to any transition target. Bound "
+                                             "transitions include: {}"),
+        ("returned", None))  # the consistency check at execute catches the unknown target first
+
+
+def test_an_empty_target_is_a_terminal_transition_like_none(parity):
+    def scenario(side):
+        k = kit(side.sm)
+        return outcome_of(k.machine(["go"], [("A", k.Out("go"), {"go": ""})]).execute)
+    assert parity.same(scenario)["result"] == ("returned", "go")
+
+
+def test_a_state_whose_request_preempt_raises_is_logged_and_runs(parity):
+    def scenario(side):
+        sm = side.sm
+
+        class Stubborn(sm.State):
+            def __init__(self):
+                sm.State.__init__(self, ["done"])
+
+            def request_preempt(self):
+                raise RuntimeError("will not")
+
+            def execute(self, ud):
+                return "done"
+        built = kit(sm).machine(["done"], [("A", Stubborn(), {})])
+        built.request_preempt()
+        return outcome_of(built.execute)
+    same = parity.same(scenario)
+    assert same["result"] == ("returned", "done")
+    assert [message.split("\n")[0] for level, message in same["logs"] if level == "error"] == [
+        "Failed to preempt contained state 'A': Traceback (most recent call last):"]

@@ -141,3 +141,29 @@ def test_an_iterators_internal_edges(parity):
         return sorted(map(str, it.get_internal_edges()))
     assert parity.same(scenario)["result"] == ["('halt', 'B', 'done')", "('odd', 'B', None)", "('stop', 'B', None)",
                                                "['next', 'B', 'B']"]
+
+
+def test_the_exhausted_outcome_is_appended_to_the_callers_outcomes_and_start_callbacks_get_the_state(parity):
+    def scenario(side):
+        sm = side.sm
+        outcomes = ["done"]
+        it = sm.Iterator(outcomes, [], [], it=[1])
+        with it:
+            sm.Iterator.set_contained_state("BODY", kit(sm).Out())
+        calls = []
+        it.register_start_cb(lambda ud, initial: calls.append(initial))
+        return outcomes, sorted(it.get_registered_outcomes()), outcome_of(it.execute), calls
+    assert parity.same(scenario)["result"] == (["done", "exhausted"], ["done", "exhausted"], ("returned", "done"),
+                                               [["BODY"]])
+
+
+def test_a_preempt_requested_while_idle_stops_the_iterator_after_its_first_item(parity):
+    def scenario(side):
+        sm = side.sm
+        body = kit(sm).Out("next", outcomes=["next"])
+        it = sm.Iterator(["done"], [], [], it=[1, 2, 3], exhausted_outcome="done")
+        with it:
+            sm.Iterator.set_contained_state("BODY", body, loop_outcomes=["next"])
+        it.request_preempt()
+        return outcome_of(it.execute), body.saw_preempt, it.preempt_requested()
+    assert parity.same(scenario)["result"] == (("returned", "next"), [False], False)

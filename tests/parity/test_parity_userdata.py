@@ -246,3 +246,19 @@ def test_printing_userdata_or_a_const_undocumented_difference(parity):
     assert theirs["result"] == ("<smach.user_data.UserData object at 0x…>", "<smach.user_data.Const object at 0x…>")
     assert ours["result"][1] == "thing"
     assert ours["result"][0].startswith("{'a': 1, 'thing': <")
+
+
+def test_a_method_of_an_input_only_object_documented_fix(parity):
+    """[bug] D33, documented: the original wraps a bound method in Const too, so it cannot be called;
+    fsm returns callables as they are."""
+    def scenario(side):
+        class Thing:
+            def speak(self):
+                return "spoken"
+        built, got = run_one(side.sm, lambda ud: outcome_of(lambda: ud.thing.speak()), input_keys=["thing"])
+        built.userdata.thing = Thing()
+        outcome_of(built.execute)
+        return got
+    theirs, ours = parity.run(scenario)
+    assert theirs["result"] == [("raised", "TypeError", "'Const' object is not callable")]
+    assert ours["result"] == [("returned", "spoken")]

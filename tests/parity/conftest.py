@@ -5,6 +5,11 @@ The original (noetic-devel, pure Python) is read from ``../shared/reference`` be
 root (CI puts a copy of shared/ there too). It is loaded under its own name, ``smach``, for this
 folder's modules only: whatever ``smach`` modules were there before are put back afterwards, and
 both implementations' loggers and shutdown checks are restored after every test.
+
+One module per section of ../shared/smach/BEHAVIORS.md (A-G). Not here: H (the introspection
+protocol) and I (smach_ros's states) need ROS. A fact that cannot run on both is named, with why, in
+its module's docstring; a documented fix of fsm (README's table, BEHAVIORS.md's [bug]) is asserted
+as the difference it is.
 """
 
 import importlib.util

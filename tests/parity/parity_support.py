@@ -18,8 +18,7 @@ class Side:
     once a line containing ``text`` was logged (children of a Concurrence wait on each other with it,
     so that their lines come in one order on both sides)."""
 
-    def __init__(self, name: str, sm: Any) -> None:
-        self.name = name
+    def __init__(self, sm: Any) -> None:
         self.sm = sm
         self.logs: list[tuple[str, str]] = []
         self.thread_errors: list[tuple[str, str]] = []  # exceptions that ended a thread of its own
@@ -43,9 +42,6 @@ class Side:
             if any(text in message for _, message in self.logs):
                 event.set()
         return event
-
-    def lines(self, level: str | None = None) -> list[str]:
-        return [message for lvl, message in self.logs if level is None or lvl == level]
 
 
 def outcome_of(fn: Callable[[], Any]) -> tuple:
@@ -82,14 +78,12 @@ class Parity:
 
     def __init__(self, original: Any) -> None:
         self.original = original
-        self.sides: list[Side] = []
 
     def run(self, scenario: Callable[[Side], Any]) -> tuple[Any, Any]:
         """``scenario(side)`` on the original, then on fsm: (original's, fsm's), each the scenario's
         result, the side's log lines and the exceptions that ended a thread, normalised."""
         results = []
-        for side in (Side("smach", self.original), Side("fsm", fsm)):
-            self.sides.append(side)
+        for side in (Side(self.original), Side(fsm)):
             hook = threading.excepthook
             threading.excepthook = lambda args: side.thread_errors.append((args.exc_type.__name__, str(args.exc_value)))
             try:

@@ -1,8 +1,6 @@
 """BEHAVIORS.md section B, the original SMACH and fsm side by side: building a StateMachine and a
 Sequence (every construction line is logged at DEBUG by both, and compared too)."""
 
-import traceback
-
 from parity_support import kit, outcome_of
 
 

@@ -4,11 +4,26 @@ Not compared: a Concurrence preempted while idle (fsm starts its children preemp
 runs them unpreempted and answers 'preempted' after they finish, so a child that waits for its
 preempt hangs it): one test below shows the difference with children that do not wait."""
 
+import threading
+
 import pytest
 
 from parity_support import kit, outcome_of
 
 pytestmark = pytest.mark.timeout(20)
+
+
+def outcome_of_in_thread(fn):
+    """Starts ``fn`` in a thread; the returned function joins it and gives what ``outcome_of`` would."""
+    box = []
+    thread = threading.Thread(target=lambda: box.append(outcome_of(fn)), daemon=True)
+    thread.start()
+
+    def join():
+        thread.join(10)
+        assert box, "the run did not end"
+        return box[0]
+    return join
 
 
 def test_a_preempt_requested_while_idle_preempts_the_first_state_of_the_next_run(parity):
@@ -151,17 +166,3 @@ def test_a_concurrence_preempted_while_idle_undocumented_difference(parity):
     assert ("info", "Concurrence serviced preempt.") in theirs["logs"]
     assert ours["result"] == (("returned", "done"), [True])
     assert ("warn", "State 'A' in concurrence did not service preempt.") in ours["logs"]
-
-
-def outcome_of_in_thread(fn):
-    """Starts ``fn`` in a thread; the returned function joins it and gives what ``outcome_of`` would."""
-    import threading
-    box = []
-    thread = threading.Thread(target=lambda: box.append(outcome_of(fn)), daemon=True)
-    thread.start()
-
-    def join():
-        thread.join(10)
-        assert box, "the run did not end"
-        return box[0]
-    return join

@@ -3,19 +3,9 @@
 from parity_support import kit, outcome_of
 
 
-def through(sm, remapper_of):
-    """Runs one state that gives its Remapper to ``remapper_of(ud)``; returns what that returned."""
-    k = kit(sm)
-    got = []
-
-    def run(ud):
-        got.append(remapper_of(ud))
-        return "done"
-    return run, got, k
-
-
 def run_one(sm, body, **keys):
-    """A machine of one state running ``body(ud)`` with the given key declarations; its result."""
+    """A machine of one state S running ``body(ud)`` with the given key declarations (and remapping):
+    (the machine, the list of what body returned)."""
     k = kit(sm)
     got = []
     built = k.machine(["done"], [("S", k.Out(lambda ud: got.append(body(ud)) or "done", **{

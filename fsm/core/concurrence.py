@@ -123,7 +123,7 @@ class Concurrence(Container):
         best = 0
         log.debug_quiet("SMACH Concurrence determining contained state outcomes.")
         for container_outcome, needed in self._outcome_map.items():
-            if all(self._child_outcomes.get(label) == o for label, o in needed.items()):
+            if all(self._child_outcomes[label] == o for label, o in needed.items()):  # an unknown label: KeyError, as SMACH
                 if len(needed) > best:
                     log.debug_quiet("Terminating concurrent split with mapped outcome.")
                     outcome, best = container_outcome, len(needed)

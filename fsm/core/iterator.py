@@ -46,9 +46,9 @@ class Iterator(Container):
         if loop_outcomes and break_outcomes:
             log.logwarn("Both loop_outcomes and break_outcomes were specified when constructing SMACH iterator container.")
         outcomes = state.get_registered_outcomes()
-        if break_outcomes:
+        if break_outcomes:  # as SMACH: the break outcomes decide, loop_outcomes given with them are ignored
             break_outcomes = list(break_outcomes)
-            loop_outcomes = list(loop_outcomes) + [o for o in outcomes if o not in break_outcomes and o not in loop_outcomes]
+            loop_outcomes = [o for o in outcomes if o not in break_outcomes]
         else:
             loop_outcomes = list(loop_outcomes)
             break_outcomes = [o for o in outcomes if o not in loop_outcomes]

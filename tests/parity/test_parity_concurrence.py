@@ -243,3 +243,16 @@ def test_a_raising_child_termination_cb_documented_fix(parity):
     first_error = [[message for level, message in side["logs"] if level == "error"][0] for side in (theirs, ours)]
     assert first_error[1] == first_error[0]
     assert first_error[0].startswith("InvalidUserCodeError: Could not execute child termination callback: Traceback")
+
+
+def test_an_outcome_map_naming_an_unknown_child_raises_key_error_at_close_and_at_execute(parity):
+    def scenario(side):
+        sm = side.sm
+        cc = sm.Concurrence(["d", "x"], "d", outcome_map={"x": {"GHOST": "done"}})
+
+        def build():
+            with cc:
+                sm.Concurrence.add("A", kit(sm).Out())
+        closing = outcome_of(build)
+        return closing, outcome_of(cc.execute)
+    assert parity.same(scenario)["result"] == (("raised", "KeyError", "'GHOST'"), ("raised", "KeyError", "'GHOST'"))

@@ -167,3 +167,19 @@ def test_a_preempt_requested_while_idle_stops_the_iterator_after_its_first_item(
         it.request_preempt()
         return outcome_of(it.execute), body.saw_preempt, it.preempt_requested()
     assert parity.same(scenario)["result"] == (("returned", "next"), [False], False)
+
+
+def test_with_both_loop_and_break_outcomes_the_break_outcomes_decide(parity):
+    """Both given: a warning, and every outcome of the state that does not break loops; an outcome
+    the state does not register (not checked by an Iterator) then breaks."""
+    def scenario(side):
+        sm = side.sm
+        it = sm.Iterator(["done", "b"], [], [], it=[1, 2], exhausted_outcome="done")
+        with it:
+            sm.Iterator.set_contained_state("B", kit(sm).Out("x", outcomes=["a", "b"]), loop_outcomes=["x"],
+                                            break_outcomes=["b"])
+        return sorted(map(str, it.get_internal_edges())), outcome_of(it.execute)
+    same = parity.same(scenario)
+    assert same["result"] == (["('b', 'B', None)", "['a', 'B', 'B']"], ("returned", "x"))
+    assert same["logs"][0] == ("warn", "Both loop_outcomes and break_outcomes were specified when constructing SMACH "
+                                       "iterator container.")

@@ -180,10 +180,10 @@ def pytest_collection_modifyitems(items):
 
 @pytest.fixture(autouse=True)
 def _machine_lines_kept_with_the_test(request):
-    """Past the unit layer, machines run in threads of their own (a server's, a robot's), and a line
+    """In the layers that serve machines, they run in threads of their own (a server's, a robot's), and a line
     they print while pytest switches between a test's phases (its capture off for an instant) landed
     among the dots. Their lines are kept with the test instead, and shown when it fails."""
-    if layer_of(request.node) in (None, "unit"):
+    if layer_of(request.node) not in ("server", "fleet", "browser", "demo"):
         yield
         return
     lines: list[str] = []

@@ -59,6 +59,7 @@ class Concurrence(Container):
         self._failed: dict[str, BaseException] = {}
         self._failed_label: str | None = None  # the child whose failure ended the last run
         self._pending = 0
+        self._stopping = False  # the run stopped waiting for its children: all done, a preempt or an error
         self._done_cond = threading.Condition()
         self._is_running = False
 
@@ -81,6 +82,7 @@ class Concurrence(Container):
             self._failed = {}
             self._failed_label = None
             self._pending = len(states)
+            self._stopping = False
         self._copy_input_keys(parent_ud, self.userdata)
         log.info_quiet("Concurrence starting with userdata: \n\t%s" % str(list(self.userdata.keys())))
         self._is_running = True
@@ -118,9 +120,14 @@ class Concurrence(Container):
         log.info_quiet("Concurrent Outcomes: " + str(self._child_outcomes))
         outcome = self._default_outcome
         best = 0
+        log.debug_quiet("SMACH Concurrence determining contained state outcomes.")
         for container_outcome, needed in self._outcome_map.items():
-            if all(self._child_outcomes.get(label) == o for label, o in needed.items()) and len(needed) > best:
-                outcome, best = container_outcome, len(needed)
+            if all(self._child_outcomes[label] == o for label, o in needed.items()):  # an unknown label: KeyError, as SMACH
+                if len(needed) > best:
+                    log.debug_quiet("Terminating concurrent split with mapped outcome.")
+                    outcome, best = container_outcome, len(needed)
+                else:
+                    log.debug_quiet("Skipping mapped outcome '%s' with fewer constraints." % container_outcome)
         if self._outcome_cb:
             try:
                 cb_outcome = self._outcome_cb(copy.copy(self._child_outcomes))
@@ -173,6 +180,8 @@ class Concurrence(Container):
                     outcome = state.execute(Remapper(self.userdata, state.get_registered_input_keys(),
                                                      state.get_registered_output_keys(), self._remappings[label]))
                 except BaseException as exc:
+                    # As SMACH's _state_runner: the child's error logs itself, traceback and all.
+                    InvalidStateError(("Could not execute child state '%s': " % label) + traceback.format_exc())
                     self._fail(label, exc)
                     return
             dbg = self._debugger
@@ -200,18 +209,28 @@ class Concurrence(Container):
                         self._fail(label, error)
                         return
                     if preempt_others:
+                        self._stop_waiting()
                         self._preempt_unfinished()
         finally:
             with self._done_cond:
                 self._pending -= 1
                 if not self._pending:
+                    self._stop_waiting()
                     self._done_cond.notify_all()
             reporting.leave(prev)
 
     def _fail(self, label: str, error: BaseException) -> None:
         with self._done_cond:
             self._failed.setdefault(label, error)
+            self._stop_waiting()
             self._preempt_unfinished()
+
+    def _stop_waiting(self) -> None:
+        """With ``_done_cond`` held: SMACH's debug line of the moment its run stops waiting (the first
+        of all children done, a preempt, a child's error or a truthy child_termination_cb), once a run."""
+        if not self._stopping:
+            self._stopping = True
+            log.logdebug("SMACH Concurrence preempting running states.")
 
     def _preempt_unfinished(self) -> None:
         for label, outcome in self._child_outcomes.items():
@@ -224,10 +243,20 @@ class Concurrence(Container):
             self._preempt_requested = True
             self._report_preempt_requested()
             if self._is_running:
+                rep = self._reporter  # the line is this Concurrence's, whichever thread asked
+                prev = reporting.enter(rep, self._path) if rep is not None else reporting.NOT_ENTERED
+                try:
+                    self._stop_waiting()
+                finally:
+                    reporting.leave(prev)
                 self._preempt_unfinished()
 
     def get_children(self) -> dict:
         return self._states
+
+    def __getitem__(self, key: str) -> State:
+        """As SMACH's: an unknown label is a KeyError naming it, with no log line."""
+        return self._states[key]
 
     def set_initial_state(self, initial_states: list[str], userdata: Any = None) -> None:
         """Every child is initial; fixed against SMACH (a TypeError on Python 3): merges the userdata."""

@@ -215,12 +215,13 @@ class Container(State):
         raise InvalidStateError("Attempting to access the currently opened container, but no container is opened.")
 
     @contextmanager
-    def opened(self, **kwargs: Any) -> TypingIterator[None]:
+    def opened(self, **kwargs: Any) -> TypingIterator["Container"]:
+        """``with container.opened() as c:`` opens it for construction (binding it, unlike ``with container``)."""
         self.open()
         prev = Container._context_kwargs
         Container._context_kwargs = kwargs
         try:
-            yield
+            yield self
         finally:
             Container._context_kwargs = prev
             self.close()
@@ -234,7 +235,7 @@ class Container(State):
             return False
         if exc_type not in (InvalidStateError, InvalidTransitionError):
             log.logerr("Error raised during SMACH container construction: \n"
-                       + "".join(traceback.format_exception(exc_type, exc_val, exc_tb)))
+                       + "\n".join(traceback.format_exception(exc_type, exc_val, exc_tb)))
         # Fixed against SMACH: the failed container is closed, so the stack and the global lock
         # are not left held; the exception still propagates.
         if self in Container._construction_stack:

@@ -45,9 +45,9 @@ class Iterator(Container):
         if loop_outcomes and break_outcomes:
             log.logwarn("Both loop_outcomes and break_outcomes were specified when constructing SMACH iterator container.")
         outcomes = state.get_registered_outcomes()
-        if break_outcomes:
+        if break_outcomes:  # as SMACH: the break outcomes decide, loop_outcomes given with them are ignored
             break_outcomes = list(break_outcomes)
-            loop_outcomes = list(loop_outcomes) + [o for o in outcomes if o not in break_outcomes and o not in loop_outcomes]
+            loop_outcomes = [o for o in outcomes if o not in break_outcomes]
         else:
             loop_outcomes = list(loop_outcomes)
             break_outcomes = [o for o in outcomes if o not in loop_outcomes]
@@ -113,6 +113,7 @@ class Iterator(Container):
         try:
             return self._state.execute(self.userdata)
         except InvalidUserCodeError:
+            log.logerr("Could not execute Iterator state '%s'" % self._state_label)
             raise
         except Exception as exc:
             raise reporting.carry_reported(InvalidUserCodeError(
@@ -141,7 +142,7 @@ class Iterator(Container):
         if len(initial_states) > 1:
             log.logwarn("Attempting to set initial state to include more than one state, but the Iterator container can only have one initial state. Taking the first one.")
         if initial_states and initial_states[0] != self._state_label:
-            log.logwarn("Attempting to set initial state of Iterator to '%s', but its only state is '%s'."
+            log.logwarn("Attempting to set state '%s' as initial state in Iterator container. The only available state is '%s'."
                         % (initial_states[0], self._state_label))
             raise KeyError()
         if userdata is not None:
@@ -155,7 +156,9 @@ class Iterator(Container):
 
     def get_internal_edges(self) -> list:
         edges: list = [[o, self._state_label, self._state_label] for o in self._loop_outcomes]
-        edges += [(o, self._state_label, self._final_outcome_map.get(o)) for o in self._break_outcomes]
+        for o in self._break_outcomes:  # as SMACH: a break that keeps its own name falls through (None)
+            mapped = self._final_outcome_map.get(o, o)
+            edges.append((o, self._state_label, None if mapped == o else mapped))
         return edges
 
     def _introspection_info(self) -> dict:

@@ -1,8 +1,9 @@
 """SMACH's logging hooks.
 
 Every line goes to the bound printer (``set_loggers``) and, when a tool listens, to the
-introspection layer as a ``log`` event. ``_quiet`` lines (start, transition, termination)
-are only printed: the events already say them and ``fsm.logfiles.transcript`` rebuilds them.
+introspection layer as a ``log`` event. ``_quiet`` lines are only printed: the start, transition
+and termination lines, which the events already say and ``fsm.logfiles.transcript`` rebuilds, and
+a Concurrence's debug lines of its outcome choice, which a replay leaves out.
 """
 
 from typing import Callable
@@ -45,6 +46,12 @@ def logerr(msg: object) -> None:
 def info_quiet(msg: str) -> None:
     """An INFO line that events already carry: printed, not sent as a log event."""
     _printers["info"](msg)
+
+
+def debug_quiet(msg: str) -> None:
+    """A DEBUG line printed, not sent as a log event: a Concurrence's outcome choice, which comes
+    after its 'Concurrent Outcomes' line (rebuilt from its terminate event), so a replay leaves it out."""
+    _printers["debug"](msg)
 
 
 def set_loggers(info: Printer, warn: Printer, debug: Printer, error: Printer) -> None:

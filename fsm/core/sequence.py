@@ -16,9 +16,12 @@ class Sequence(StateMachine):
 
     @staticmethod
     def add(label: str, state: State, transitions: dict | None = None, remapping: dict | None = None) -> State:
-        """Add a state; the previous one's connector outcome leads here unless it was given explicitly."""
+        """Add a state; the previous one's connector outcome leads here unless it was given explicitly.
+
+        As SMACH: the previous state is linked first, then this one added."""
         self = Sequence._currently_opened_container()
-        StateMachine.add(label, state, transitions, remapping)
+        if transitions is None:
+            transitions = {}
         previous = self._last_added_seq_label
         if previous is not None:
             previous_transitions = self._transitions[previous]
@@ -29,4 +32,4 @@ class Sequence(StateMachine):
             except Exception:
                 log.logerr("Attempting to construct smach state sequence failed.")
         self._last_added_seq_label = label
-        return state
+        return StateMachine.add(label, state, transitions, remapping)

@@ -1,5 +1,6 @@
 """Userdata: a container's key/value scope, and the Remapper through which a child sees it."""
 
+import copy
 from typing import Any, Iterable, Mapping
 
 from . import log
@@ -21,7 +22,7 @@ class UserData:
             return self._data[name]
         except KeyError:
             log.logerr("Userdata key '%s' not available. Available keys are: %s" % (name, list(self._data.keys())))
-            raise KeyError() from None
+            raise KeyError()  # in the except block, as SMACH: the traceback shows the missing key too
 
     def __setattr__(self, name: str, value: Any) -> None:
         if name[0] == "_":
@@ -31,6 +32,13 @@ class UserData:
         dirty = self._dirty
         if dirty is not None:
             dirty.add(name)
+
+    def __setitem__(self, key: str, value: Any) -> None:
+        """Any key, one with a leading underscore too (as SMACH's: only attribute syntax keeps those for the object)."""
+        self._data[key] = value
+        dirty = self._dirty
+        if dirty is not None:
+            dirty.add(key)
 
     def track_writes(self) -> None:
         """From now on, remember the keys written (for a reporter's ``userdata`` events)."""
@@ -46,7 +54,6 @@ class UserData:
         return {k: data[k] for k in dirty if k in data}
 
     __getitem__ = __getattr__
-    __setitem__ = __setattr__
 
     def keys(self) -> list[str]:
         return list(self._data.keys())
@@ -61,23 +68,20 @@ class UserData:
             self[key] = value
 
     def extract(self, keys: Iterable[str], remapping: Mapping[str, str]) -> "UserData":
+        """A new UserData holding shallow copies of ``keys``, each under its local name (``remapping``
+        maps local names to these keys), as SMACH's."""
         ud = UserData()
-        reverse = {}
-        for k, v in remapping.items():
-            reverse.setdefault(v, []).append(k)
-        for v, ks in reverse.items():
-            if len(ks) > 1:
-                log.logerr("SMACH userdata remapping is not one-to-one: " + str(reverse))
-                break
+        reverse = {v: k for k, v in remapping.items()}
+        if len(reverse) != len(remapping):
+            log.logerr("SMACH userdata remapping is not one-to-one: " + str(remapping))
         for k in keys:
-            rmk = remapping.get(k, k)
-            ud[rmk] = self[k]
+            ud[reverse.get(k, k)] = copy.copy(self[k])
         return ud
 
     def merge(self, ud: "UserData", keys: Iterable[str], remapping: Mapping[str, str]) -> None:
+        """Shallow copies of ``ud``'s ``keys``, each stored under ``remapping``'s name for it, as SMACH's."""
         for k in keys:
-            rmk = remapping.get(k, k)
-            self[rmk] = ud[k]
+            self[remapping.get(k, k)] = copy.copy(ud[k])
 
     def __str__(self) -> str:
         return str(self._data)
@@ -120,6 +124,7 @@ class Const:
 def get_const(obj: Any) -> Any:
     """Wrap objects with a ``__dict__``; callables are returned as they are so they can run."""
     if hasattr(obj, "__dict__") and not callable(obj):
+        log.logdebug("Making const '%s'" % str(obj))  # and Const logs it again, as in SMACH
         return Const(obj)
     return obj
 

@@ -10,7 +10,7 @@ class CBInterface:
                  input_keys: Iterable[str] | None = None, output_keys: Iterable[str] | None = None,
                  io_keys: Iterable[str] | None = None) -> None:
         self._cb = cb
-        self._outcomes = set(outcomes or ())
+        self._outcomes = list(outcomes or ())  # in the order given, as SMACH
         # Fixed against SMACH: io_keys count as both input and output keys.
         self._input_keys = set(input_keys or ()) | set(io_keys or ())
         self._output_keys = set(output_keys or ()) | set(io_keys or ())

@@ -76,6 +76,19 @@ def test_child_exception_raises_invalid_state_error_from_execute(logs):
 
 
 @pytest.mark.timeout(5)
+def test_child_exception_logs_the_child_error_with_its_traceback_then_the_concurrence_error(logs):
+    def bad(ud):
+        raise ValueError("boom")
+    cc = concurrence(["d"], "d", [("BOOM", Out(bad))])
+    with pytest.raises(smach.InvalidStateError):
+        cc.execute()
+    child_error, concurrence_error = logs.error
+    assert child_error.startswith("InvalidStateError: Could not execute child state 'BOOM': Traceback (most recent call last):")
+    assert child_error.endswith("ValueError: boom\n")
+    assert concurrence_error == "InvalidStateError: A concurrent state raised an exception during execution."
+
+
+@pytest.mark.timeout(5)
 def test_child_returning_none_ends_the_concurrence_with_an_error_instead_of_hanging(logs):
     cc = concurrence(["d"], "d", [("OK", Out("done")), ("NONE", Out(None, outcomes=["done"]))])
     with pytest.raises(smach.InvalidStateError) as info:
@@ -206,3 +219,12 @@ def test_shutdown_check_stops_the_concurrence_waiting_for_its_children(logs):
         assert not cc.is_running()
     finally:
         release.set()
+
+
+def test_a_run_logs_smachs_debug_lines_when_it_stops_waiting_and_while_it_picks_the_mapped_outcome(logs):
+    cc = _two("done", "done", outcome_map={"x": {"A": "done", "B": "done"}, "y": {"A": "done"}})
+    assert cc.execute() == "x"
+    assert logs.debug == ["SMACH Concurrence preempting running states.",
+                          "SMACH Concurrence determining contained state outcomes.",
+                          "Terminating concurrent split with mapped outcome.",
+                          "Skipping mapped outcome 'y' with fewer constraints."]

@@ -2,6 +2,7 @@
 
 import ast
 import threading
+import traceback
 
 import fsm as smach
 import pytest
@@ -167,6 +168,15 @@ def test_user_exception_inside_with_logs_the_construction_traceback(logs):
     assert "ValueError: user bug" in logs.error[0]
 
 
+def test_the_construction_traceback_is_joined_with_newlines_as_smach_does(logs):
+    error = ValueError("user bug")
+    with pytest.raises(ValueError):
+        with smach.StateMachine(outcomes=["done"]):
+            raise error
+    assert logs.error == ["Error raised during SMACH container construction: \n"
+                          + "\n".join(traceback.format_exception(ValueError, error, error.__traceback__))]
+
+
 def test_smach_exception_inside_with_logs_no_construction_traceback(logs):
     with pytest.raises(smach.InvalidStateError):
         with smach.StateMachine(outcomes=["done"]):
@@ -230,6 +240,17 @@ def test_sequence_keeps_an_explicit_connector_transition_and_last_state_falls_th
     assert seq.execute() == "succeeded"
     assert order == ["S1", "S3"]
     assert logs.info[-1] == "State machine terminating 'S3':'succeeded':'succeeded'"
+
+
+def test_a_sequence_state_without_the_connector_outcome_is_logged_at_add_and_the_sequence_still_runs(logs):
+    seq = smach.Sequence(outcomes=["done", "next"], connector_outcome="next")
+    with seq:
+        smach.Sequence.add("S1", Out("done"))
+        smach.Sequence.add("S2", Out("done"))
+    assert logs.error == ["InvalidTransitionError: Specified outcome 'next' on state 'S1', which only has available "
+                          "registered outcomes: ('done',)", "Attempting to construct smach state sequence failed."]
+    assert seq.execute() == "done"
+    assert logs.error[2:] == []
 
 
 def test_sequence_with_remapping_passes_userdata_between_states():

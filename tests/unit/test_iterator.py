@@ -196,3 +196,19 @@ def test_getting_an_unknown_state_from_an_iterator_logs_its_one_state_in_the_sin
     with pytest.raises(KeyError):
         it["NOPE"]
     assert logs.error == ["Attempting to get state 'NOPE' from Iterator container. The only available state is 'BODY'."]
+
+
+def test_a_wrong_initial_label_is_warned_in_smachs_words(logs):
+    it = _iterator([1], Out("next", outcomes=["next"]), contained={"loop_outcomes": ["next"]})
+    with pytest.raises(KeyError):
+        it.set_initial_state(["NOPE"], smach.UserData())
+    assert logs.warn == ["Attempting to set state 'NOPE' as initial state in Iterator container. The only available "
+                         "state is 'BODY'."]
+
+
+def test_an_invalid_user_code_error_from_the_contained_state_is_logged_and_passed_on(logs):
+    inner = machine(["done"], [("READ", Out(lambda ud: ud.undeclared), {})])
+    it = _iterator([1], inner)
+    with pytest.raises(smach.InvalidUserCodeError):
+        it.execute()
+    assert logs.error[-1] == "Could not execute Iterator state 'BODY'"

@@ -246,3 +246,17 @@ def test_cbstate_passes_cb_args_and_kwargs():
                           outcomes=["done"])
     assert machine(["done"], [("CB", state, {})]).execute() == "done"
     assert seen == [(1, 2)]
+
+
+def test_extract_copies_keys_to_their_local_names_and_merge_copies_them_back_under_the_remapped_names(logs):
+    parent = smach.UserData()
+    parent.p = [1]
+    parent.q = 2
+    local = parent.extract(["p", "q"], {"local_p": "p"})
+    assert sorted(local.keys()) == ["local_p", "q"]
+    assert local.local_p == [1] and local.local_p is not parent.p
+    into = smach.UserData()
+    into.merge(local, ["local_p"], {"local_p": "back"})
+    assert into.keys() == ["back"] and into.back is not local.local_p
+    parent.extract([], {"a": "p", "b": "p"})
+    assert logs.error == ["SMACH userdata remapping is not one-to-one: {'a': 'p', 'b': 'p'}"]

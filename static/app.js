@@ -9,7 +9,7 @@ import { Audit } from "./audit.js";
 import { showBadge } from "./badge.js";
 import { Breadcrumb } from "./breadcrumb.js";
 import { Breakpoints, debugMarks } from "./breakpoints.js";
-import { readLink, writeLink } from "./deeplink.js";
+import { LinkFollower, readLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
 import { DebugBar } from "./debugger.js";
 import { Depth } from "./depth.js";
@@ -17,6 +17,8 @@ import { DetailsPanel } from "./details.js";
 import { showMenu } from "./dialogs.js";
 import { Feed } from "./feed.js";
 import { GraphView } from "./graph.js";
+import { GraphToolbar } from "./graph_toolbar.js";
+import { MachineDrawing } from "./machine_drawing.js";
 import { Lease } from "./lease.js";
 import { Machines, isReplay, showRunState } from "./machines.js";
 import { Minimap } from "./minimap.js";
@@ -26,21 +28,19 @@ import { EventLog } from "./eventlog.js";
 import { BEHIND_FRAME_MS, Renderer } from "./renderer.js";
 import { Playhead } from "./timetravel.js";
 import { Timeline } from "./timeline.js";
+import { TimelineLoader } from "./timeline_loader.js";
 import { TreeView } from "./tree.js";
 import { UserdataPanel, keyHistory } from "./userdata.js";
 import { SceneView } from "./scene.js";
 import { SearchPalette } from "./search.js";
 import { shownStatus, view } from "./shown.js";
-import { containers, parentPath } from "./status.js";
+import { parentPath } from "./status.js";
 import { Store } from "./store.js";
 
 const $ = (id) => document.getElementById(id);
 const failure = (err) => err.detail || err.message;
 
 const KEY_HISTORY_LIMIT = 10000; // events of a run read for one key's history
-const TIMELINE_REFRESH_MS = 1000; // a live machine's timeline is asked again this often
-const TREE_WAIT_MS = 250; // the hierarchy's rows wait this long at most for the drawing
-const LINK_EVERY_MS = 250; // the address names the instant at most this often (browsers throttle replaceState)
 
 const store = new Store();
 const playhead = new Playhead(api, store, (err) => store.say("Could not show that instant: " + failure(err), "warn"));
@@ -49,21 +49,18 @@ const graph = new GraphView($("graph"), {
   select: (path) => select(path),
   contextmenu: (path, x, y) => stateMenu(path, x, y),
   toggle: (path, isCluster) => depth.toggle(path, isCluster),
-  userPanned: () => stopFollowing(),
+  userPanned: () => toolbar.stopFollowing(),
 });
-function stopFollowing() {
-  $("follow").checked = false;
-  graph.follow = false;
-}
+const toolbar = new GraphToolbar(graph, () => renderer.queue());
 new Breadcrumb($("crumb-bar"), $("fit"), graph, {
   label: (path) => store.state.nodes.get(path)?.label ?? path,
   fit: (path) => {
-    stopFollowing();
+    toolbar.stopFollowing();
     graph.fitPath(path);
   },
 });
 new Minimap($("minimap"), graph, (x, y) => {
-  stopFollowing();
+  toolbar.stopFollowing();
   graph.centreOn(x, y);
 });
 new Panes(document.querySelector("main.layout"));
@@ -86,13 +83,9 @@ const log = new EventLog($("log"), {
   },
 });
 log.nodeOf = (path) => store.state.nodes.get(path);
-let timelineRange = { since_t: null, until_t: null }; // the range the timeline shows (null: the whole run)
 const timeline = new Timeline($("timeline"), {
   seek: (target) => playhead.seek(target),
-  range: (range) => {
-    timelineRange = range;
-    loadTimeline();
-  },
+  range: (range) => timelineLoader.setRange(range),
   play: () => playhead.play(),
   pause: () => playhead.pause(),
   speed: (x) => playhead.setSpeed(x),
@@ -114,7 +107,7 @@ const audit = new Audit(store);
 $("audit-btn").addEventListener("click", () => audit.open());
 const breakpoints = new Breakpoints(store, controls);
 const debugBar = new DebugBar(store, controls);
-const depth = new Depth($("depth"), store, () => graph.openPaths(), (semantic) => loadGraph(semantic), api.anyOpenSet);
+const depth = new Depth($("depth"), store, () => graph.openPaths(), (semantic) => drawing.load(semantic), api.anyOpenSet);
 const details = new DetailsPanel($("details"), store, api);
 const search = new SearchPalette(store, (entry) => goTo(entry));
 $("search-btn").addEventListener("click", () => search.open());
@@ -127,12 +120,15 @@ const feed = new Feed(store, api, {
   missed: (count) => store.say(`${count} events missed: resynchronised from a snapshot`, "warn"),
 });
 const renderer = new Renderer(store, [render, renderPanels]);
+const drawing = new MachineDrawing(store, api, { graph, depth, tree, userdata }, () => renderer.queue());
+const timelineLoader = new TimelineLoader(store, api, timeline);
+const address = new LinkFollower(store);
 
 // ---------------------------------------------------------------- what each change of the store draws
 
 store.subscribe((state, part) => {
   if (part === "notice") showNotice($("notice"), $("banner"), state);
-  else if (part === "structure") structureChanged(state);
+  else if (part === "structure") drawing.restructured(state);
   else if (part === "lease") lease.update(state);
   if (part === "machine" || part === "machines" || part === "role") lease.watch();
   if (part === "machines") machines.update(state);
@@ -155,8 +151,7 @@ function openMachine(name) {
     playhead.setSpeed(entry.replay.speed);
     timeline.showSpeed(entry.replay.speed);
   }
-  timelineRange = { since_t: null, until_t: null };
-  loadTimeline();
+  timelineLoader.open();
   machines.opened(name);
   depth.reset();
   notices.forget(); // they were about the machine shown so far
@@ -165,55 +160,6 @@ function openMachine(name) {
   userdata.show(null);
   log.reset();
   feed.open(name);
-}
-
-function structureChanged({ live }) {
-  const root = live.structure;
-  graph.index(store.state.nodes.values());
-  depth.restructured();
-  // The drawing first: a big machine's hierarchy takes longer to build and lay out than the server's
-  // drawing takes to come, so its rows wait for the drawing (at most TREE_WAIT_MS).
-  const drawn = loadGraph();
-  Promise.race([drawn, new Promise((done) => setTimeout(done, TREE_WAIT_MS))]).then(() => {
-    if (store.state.live?.structure !== root) return; // another machine or structure since
-    tree.build(root);
-    renderer.queue();
-  });
-  userdata.setContainers([...containers(root)]);
-  if (!userdata.path || !store.state.nodes.has(userdata.path)) userdata.show(root ? root.path : null);
-}
-
-/** Draw the layout of the structure with the containers `depth` opens (the server lays it out);
- * `semantic`: opened or closed as the machine moved: what the user looks at stays where it is. */
-async function loadGraph(semantic = false) {
-  const { name, live, structureKey } = store.state;
-  if (!live.structure) return;
-  const expand = depth.paths();
-  const key = JSON.stringify([name, structureKey, expand]);
-  try {
-    const anchor = semantic ? () => store.state.selected || graph.activePath : null;
-    if (await graph.load(key, () => api.graphSvg(name, expand), anchor)) {
-      depth.laidOut();
-      renderer.queue();
-    }
-  } catch (err) {
-    if (name !== store.state.name) return;
-    const text = "Could not draw the graph: " + failure(err);
-    if (err.status === 404 && graph.key) store.say(text, "warn"); // that drawing is missing: keep the one shown
-    else graph.clear(text);
-  }
-}
-
-/** Ask the server for the timeline of the machine shown, in the range the timeline shows. */
-async function loadTimeline() {
-  const name = store.state.name;
-  if (name === null) return;
-  try {
-    const data = await api.timeline(name, timelineRange);
-    if (name === store.state.name) timeline.setData(data);
-  } catch (err) {
-    if (name === store.state.name) store.say("Could not read the timeline: " + failure(err), "warn");
-  }
 }
 
 /** The history of `key` of container `path` in the current run, beside the userdata. */
@@ -248,7 +194,7 @@ async function goTo(entry) {
     renderer.queue();
     return;
   }
-  stopFollowing(); // the user looks elsewhere than the active state
+  toolbar.stopFollowing(); // the user looks elsewhere than the active state
   await depth.reveal(entry.path);
   select(entry.path);
   graph.centrePath(entry.path);
@@ -293,17 +239,6 @@ function showInstant({ live, instant }) {
   feed.pace(past ? BEHIND_FRAME_MS : 0);
 }
 
-let linkTimer = null;
-/** The address names the instant shown (at most every LINK_EVERY_MS). */
-function updateLink() {
-  if (linkTimer) return;
-  linkTimer = setTimeout(() => {
-    linkTimer = null;
-    const { name, instant } = store.state;
-    if (name !== null) writeLink(name, instant.past ? instant.status.last_seq : null);
-  }, LINK_EVERY_MS);
-}
-
 /** The first frame: the machine at the instant shown (graph, hierarchy, details, timeline, top bar). */
 function render(state) {
   if (!state.live) return;
@@ -317,7 +252,7 @@ function render(state) {
   if (graph.follow && graph.activePath) tree.reveal(graph.activePath);
   showInstant(state);
   scene.showPose(state.instant.past ? s.pose : null);
-  updateLink();
+  address.update();
   machines.update(state);
   updateTopBar(state);
 }
@@ -336,28 +271,10 @@ function renderPanels(state) {
 
 // ---------------------------------------------------------------- go
 
-$("fit").addEventListener("click", () => graph.fit());
-$("zoom-in").addEventListener("click", () => graph.zoomStep(1));
-$("zoom-out").addEventListener("click", () => graph.zoomStep(-1));
-$("zoom-readable").addEventListener("click", () => graph.zoomReadable());
-$("follow").addEventListener("change", (e) => {
-  graph.follow = e.target.checked;
-  renderer.queue();
-});
-document.addEventListener("keydown", (e) => {
-  if (e.target.closest("input, textarea, select, dialog")) return;
-  if (e.key === "f") graph.fit();
-  else if (e.key === "+" || e.key === "=") graph.zoomStep(1);
-  else if (e.key === "-") graph.zoomStep(-1);
-  else if (e.key === "r") graph.zoomReadable();
-});
 setInterval(() => { // the badge's rate and latency move on with time
   updateBadge(store.state);
   updateTopBar(store.state);
 }, 500);
-setInterval(() => {
-  if (!store.state.instant.replay && !document.hidden) loadTimeline(); // a live run grows
-}, TIMELINE_REFRESH_MS);
 setInterval(() => notices.checkOverdue(), 500);
 
 // For the console and the browser tests: what the page shows, read-only (the machine, the status

@@ -127,16 +127,28 @@ const address = new LinkFollower(store);
 // ---------------------------------------------------------------- what each change of the store draws
 
 store.subscribe((state, part) => {
-  if (part === "notice") showNotice($("notice"), $("banner"), state);
-  else if (part === "structure") drawing.restructured(state);
-  else if (part === "lease") lease.update(state);
-  if (part === "machine" || part === "machines" || part === "role") lease.watch();
-  if (part === "machines") machines.update(state);
-  if (part === "machines" || part === "connection" || part === "role" || part === "lease") updateTopBar(state);
-  if (part === "connection") updateBadge(state);
-  // Events are drawn at a pace, and the instant while it plays; what the user does at the next frame.
-  if (part === "live" || part === "instant" || part === "selection" || part === "machine") {
-    renderer.queue(part === "live" || (part === "instant" && state.instant.playing));
+  switch (part) {
+    case "notice": return showNotice($("notice"), $("banner"), state);
+    case "structure": return drawing.restructured(state);
+    case "machines":
+      machines.update(state);
+      lease.watch(); // whether this page may control the machine shown may have changed
+      return updateTopBar(state);
+    case "role":
+      lease.watch();
+      return updateTopBar(state);
+    case "lease": return updateTopBar(state);
+    case "connection":
+      updateBadge(state);
+      return updateTopBar(state);
+    // The machine at the instant shown: events are drawn at a pace, and the instant while it plays;
+    // what the user does at the next frame.
+    case "machine":
+      lease.watch();
+      return renderer.queue();
+    case "live": return renderer.queue(true);
+    case "instant": return renderer.queue(state.instant.playing);
+    case "selection": return renderer.queue();
   }
 });
 

@@ -1,10 +1,11 @@
-// The page's one store: everything the dashboard shows is read from `store.state`, and every change
-// goes through one of the store's methods, which tells the subscribers which part changed. The parts:
-// the machine shown (its name, its live status as its stream says, the structure's nodes, the
-// selection), the instant looked at (timetravel.js moves it), the served machines (machines.js polls
-// them), the stream's connection, this page's role and who holds the lease (lease.js), the notice
-// line and the banner. The views are drawn from the state (app.js wires who draws on what change);
-// none keeps a copy of it, and nothing is read back from the page's elements.
+// The page's one store: what the dashboard knows of the machine shown and of its server is
+// `store.state`, and every change goes through one of the store's methods, which tells the
+// subscribers which part changed. The parts: the machine shown (its name, its live status as its
+// stream says, the structure's nodes, the selection), the instant looked at (timetravel.js moves
+// it), the served machines (machines.js polls them), the stream's connection, this page's role and
+// who holds the lease (lease.js), the notice line and the banner. The views draw from the state
+// (app.js wires which draws on what change) and keep only what they draw (the log's rows, the
+// timeline's bands); nothing is read back from the page's elements.
 
 import { Status, allNodes } from "./status.js";
 
@@ -26,8 +27,9 @@ export class Store {
       // The instant looked at: past (else the live status is drawn), its Status and the log's events
       // around it ({events, seq}) when past, whether it plays, whether the machine is a replay.
       instant: presentOf(false),
-      machines: { list: [], online: true, endings: new Map() }, // /api/machines, whether the server answers,
-      // and {seq, error} of the other machines that ended without an outcome
+      // /api/machines, whether the server answers, and {seq, error} by name of the other machines
+      // that ended without an outcome
+      machines: { list: [], online: true, endings: new Map() },
       connection: "idle", // the state of the stream of the machine shown (stream.js)
       role: "operator", // "viewer": this page may watch, not control
       lease: null, // who holds the lease of the machine shown ({holder, yours, deadman}; null: unknown)
@@ -38,7 +40,7 @@ export class Store {
 
   /** Call `listener(state, part)` after each change; `part` names what changed: "machine" (another
    * machine shown), "live", "structure", "selection", "instant", "machines", "connection", "role",
-   * "lease", "notice". Returns the function that unsubscribes it. */
+   * "lease", "notice" (the notice line or the banner). Returns the function that unsubscribes it. */
   subscribe(listener) {
     this.listeners.add(listener);
     return () => this.listeners.delete(listener);
@@ -117,7 +119,8 @@ export class Store {
     this._changed("machines");
   }
 
-  /** How machine `name`, one of the others, ended at `seq`: `error` (null: not known yet, or none). */
+  /** How machine `name`, one of the others, ended: `ending` {seq, error} (error null: not known yet,
+   * or none); null: to be asked again. */
   setEnding(name, ending) {
     if (ending) this.state.machines.endings.set(name, ending);
     else this.state.machines.endings.delete(name);

@@ -25,8 +25,9 @@ def run_in_node(script: str, events: list[dict]) -> object:
                f'import {{ RunNotices }} from "{(STATIC / "notice.js").as_uri()}";\n'
                'import { readFileSync } from "node:fs";\n'
                "const events = JSON.parse(readFileSync(0, 'utf8'));\n")
-    # The page's modules are ES modules in files named .js, with no package.json to say so.
-    out = subprocess.run([NODE, "--experimental-default-type=module", "--input-type=module", "-e", prelude + script],
+    # The page's modules are ES modules in files named .js with no package.json to say so: Node (20.19,
+    # 22.7 and later) tells them by their syntax.
+    out = subprocess.run([NODE, "--input-type=module", "-e", prelude + script],
                          input=json.dumps(events), capture_output=True, text=True, timeout=30, check=True)
     return json.loads(out.stdout)
 

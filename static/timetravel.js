@@ -1,7 +1,8 @@
 // The playhead: which instant of the machine shown the page draws, kept in the store (store.js,
-// `state.instant`) and moved only from here. Live (the stream's present) or an event of the past, rebuilt by the server (GET .../status?seq=N) and moved on locally with the
-// same reducer (status.js) from pages of history (GET .../history) while it plays. Seeks are
-// coalesced: one request in flight, the newest target wins, so a drag never queues up requests.
+// `state.instant`) and moved only from here. Live (the stream's present) or an event of the past,
+// rebuilt by the server (GET .../status?seq=N) and moved on locally with the same reducer
+// (status.js) from pages of history (GET .../history) while it plays. Seeks are coalesced: one
+// request in flight, the newest target wins, so a drag never queues up requests.
 
 import { Status } from "./status.js";
 import { presentOf } from "./store.js";

@@ -25,6 +25,7 @@ import { Minimap } from "./minimap.js";
 import { Panes } from "./panes.js";
 import { RunNotices, showNotice } from "./notice.js";
 import { EventLog } from "./eventlog.js";
+import { exposeToConsole } from "./page_probe.js";
 import { BEHIND_FRAME_MS, Renderer } from "./renderer.js";
 import { Playhead } from "./timetravel.js";
 import { Timeline } from "./timeline.js";
@@ -289,18 +290,6 @@ setInterval(() => { // the badge's rate and latency move on with time
 }, 500);
 setInterval(() => notices.checkOverdue(), 500);
 
-// For the console and the browser tests: what the page shows, read-only (the machine, the status
-// shown, the live one, the instant, the selected path), and clearNotice().
-window.fsmscope = Object.freeze({
-  get name() { return store.state.name; },
-  get status() { return shownStatus(store.state); },
-  get liveStatus() { return store.state.live; },
-  get instant() {
-    const { past, status, playing } = store.state.instant;
-    return { past, seq: status ? status.last_seq : null, t: status ? status.last_t : null, playing };
-  },
-  get selected() { return store.state.selected; },
-  clearNotice: () => store.clearNotice(),
-});
+exposeToConsole(store);
 showNotice($("notice"), $("banner"), store.state);
 machines.poll();

@@ -25,7 +25,7 @@ export function holdersAt(events) {
 }
 
 export class Audit {
-  /** @param {Store} store the machine shown (store.js) */
+  /** @param {Store} store the page's store (store.js): the machine shown */
   constructor(store) {
     this.store = store;
     this.dialog = document.getElementById("audit-dialog");
@@ -41,13 +41,13 @@ export class Audit {
 
   /** Open the audit of the machine shown. */
   open() {
-    this.dialog.querySelector(".dlg-machine").textContent = this.store.name || "";
+    this.dialog.querySelector(".dlg-machine").textContent = this.store.state.name || "";
     this.dialog.showModal();
     return this.load();
   }
 
   async load() {
-    const name = this.store.name;
+    const name = this.store.state.name;
     const table = this.dialog.querySelector("tbody");
     try {
       const page = await api.history(name, { kinds: "control", limit: LIMIT, order: "desc" });

@@ -5,6 +5,7 @@
 
 import { api } from "./api.js";
 import { editBreakpoint } from "./dialogs.js";
+import { showsLive } from "./shown.js";
 import { breakpointText } from "./transcript.js";
 
 /** @typedef {import("./schema.js").Breakpoint} Breakpoint */
@@ -20,22 +21,20 @@ export function debugMarks(status) {
 
 export class Breakpoints {
   /**
-   * @param {Store} store the machine shown (store.js)
+   * @param {Store} store the page's store (store.js)
    * @param {Controls} controls its controls (controls.js): why this page may not control it, and `ask`
-   * @param {() => boolean} live whether the page shows the live machine (its stream live, not looking back)
    */
-  constructor(store, controls, live) {
+  constructor(store, controls) {
     this.store = store;
     this.controls = controls;
-    this.live = live;
   }
 
   /** The state menu's breakpoint items for the state at `path`, disabled (the item saying why) when
    * the server would refuse them or the page is not showing the live machine. */
   items(path) {
     const own = this._set().filter((bp) => bp.state === path);
-    const why = path === this.store.status.root_path ? "the root is in no container that could hold it"
-      : this.controls.refusal() || (this.live() ? "" : "not live: go back to live to set breakpoints");
+    const why = path === this.store.state.live.root_path ? "the root is in no container that could hold it"
+      : this.controls.refusal() || (showsLive(this.store.state) ? "" : "not live: go back to live to set breakpoints");
     const item = (label, action, title = why) => ({ label, action, disabled: Boolean(why), title });
     /** @type {(at: string) => Breakpoint} */
     const breakpoint = (at) => ({ state: path, at, outcome: null, when: null });
@@ -55,7 +54,7 @@ export class Breakpoints {
 
   /** The machine's breakpoints as its live status says now. */
   _set() {
-    return this.store.status.debug?.breakpoints ?? [];
+    return this.store.state.live.debug?.breakpoints ?? [];
   }
 
   /** Replace the set by `change(set)`; a notice says how the server answered. */
@@ -66,8 +65,8 @@ export class Breakpoints {
   /** "Break when…": the dialog stays open on the server's refusal, which it shows. */
   _edit(path) {
     editBreakpoint({
-      state: path, outcomes: this.store.nodes.get(path)?.outcomes ?? [],
-      submit: (bp) => api.setBreakpoints(this.store.name, [...this._set(), bp]),
+      state: path, outcomes: this.store.state.nodes.get(path)?.outcomes ?? [],
+      submit: (bp) => api.setBreakpoints(this.store.state.name, [...this._set(), bp]),
     });
   }
 }

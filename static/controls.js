@@ -7,7 +7,6 @@ import { confirmPreempt, editInitialState } from "./dialogs.js";
 import { setText } from "./dom.js";
 import { heldText } from "./loop.js";
 import { controlRefusal } from "./machines.js";
-import { notice } from "./notice.js";
 import { containerKind } from "./schema.js";
 import { parentPath } from "./status.js";
 
@@ -15,38 +14,32 @@ const $ = (id) => document.getElementById(id);
 
 export class Controls {
   /**
-   * @param {Store} store the machine shown (store.js)
-   * @param {Machines} machines the served machines (machines.js)
+   * @param {Store} store the page's store (store.js): the machine shown, its entry, this page's role
    * @param {RunNotices} notices what the notice says of its runs (notice.js)
-   * @param {() => boolean} live whether its stream is live
    */
-  constructor(store, machines, notices, live) {
+  constructor(store, notices) {
     this.store = store;
-    this.machines = machines;
     this.notices = notices;
-    this.live = live;
-    this.viewer = false;
     $("preempt-btn").addEventListener("click", () => this._preempt());
     $("start-btn").addEventListener("click", () => this.ask("Start", api.start));
     $("hold-btn").addEventListener("click", () => this.ask("Stop after this run", api.hold, ": then the loop waits for Start"));
   }
 
-  /** The page's role (api.session): a viewer sees no control. */
-  setRole(role) {
-    this.viewer = role === "viewer";
-    this.update();
+  /** Whether this page has a viewer's token: it sees no control. */
+  get viewer() {
+    return this.store.state.role === "viewer";
   }
 
   /** Why the machine shown takes no control from this page now; "" when it does. */
   refusal() {
-    return this.viewer ? "this page has a viewer's token: it may watch, not control" : controlRefusal(this.machines.current());
+    return this.viewer ? "this page has a viewer's token: it may watch, not control" : controlRefusal(this.store.current());
   }
 
-  /** Enable what the machine shown accepts now; show whether its loop is held. */
-  update() {
-    const entry = this.machines.current();
-    const running = this.store.status ? this.store.status.running : false;
-    const live = this.machines.online && this.live();
+  /** Enable what the machine shown accepts now (`state`: the store's); show whether its loop is held. */
+  update(state) {
+    const entry = this.store.current();
+    const running = state.live ? state.live.running : false;
+    const live = state.machines.online && state.connection === "live";
     const controllable = !this.refusal();
     $("preempt-btn").disabled = !live || !running || !controllable;
     $("start-btn").disabled = !live || running || !controllable || !entry.can_start;
@@ -62,7 +55,7 @@ export class Controls {
 
   /** The menu item "Set as initial state…" for the state at `path`. */
   initialStateItem(path) {
-    const nodes = this.store.nodes;
+    const nodes = this.store.state.nodes;
     const node = nodes.get(path);
     const container = parentPath(path);
     const parent = container ? nodes.get(container) : null;
@@ -78,31 +71,31 @@ export class Controls {
   }
 
   async _setInitial(container, state) {
-    const name = this.store.name;
+    const name = this.store.state.name;
     const ok = await editInitialState({
-      container, state, userdata: this.store.status.containers[container]?.userdata || {},
+      container, state, userdata: this.store.state.live.containers[container]?.userdata || {},
       submit: (value) => api.setInitialState(name, container, [state], value),
     });
     if (ok) this._say(name, `Initial state of ${container} set to ${state} (next run)`, "ok");
   }
 
   async _preempt() {
-    const name = this.store.name;
+    const name = this.store.state.name;
     const answer = await confirmPreempt(name);
     if (!answer) return;
     this.notices.preemptSent();
     try {
       const ack = await api.preempt(name, answer.reason);
-      if (name === this.store.name) this.notices.preemptAccepted(ack.seq);
+      if (name === this.store.state.name) this.notices.preemptAccepted(ack.seq);
     } catch (err) {
-      if (name === this.store.name) this.notices.preemptFailed(err);
+      if (name === this.store.state.name) this.notices.preemptFailed(err);
     }
   }
 
   /** Ask the server for `what` by `call(name)` (the debugger's controls too); a notice says how it
    * answered: the event the control caused, or the server's refusal (a 409 says why). */
   async ask(what, call, then = "") {
-    const name = this.store.name;
+    const name = this.store.state.name;
     try {
       const ack = await call(name);
       const event = ack.seq === undefined ? "" : ` (event ${ack.seq})`;
@@ -114,6 +107,6 @@ export class Controls {
 
   /** A notice about machine `name`, dropped when the page has moved to another machine meanwhile. */
   _say(name, text, level, sticky) {
-    if (name === this.store.name) notice(text, level, sticky);
+    if (name === this.store.state.name) this.store.say(text, level, sticky);
   }
 }

@@ -6,6 +6,7 @@
 import { api } from "./api.js";
 import { showMenu } from "./dialogs.js";
 import { setText } from "./dom.js";
+import { shownStatus, showsLive } from "./shown.js";
 import { debugLine } from "./transcript.js";
 
 const $ = (id) => document.getElementById(id);
@@ -23,14 +24,12 @@ export function pausedText(debug) {
 
 export class DebugBar {
   /**
-   * @param {Store} store the machine shown (store.js)
+   * @param {Store} store the page's store (store.js)
    * @param {Controls} controls its controls (controls.js): the page's role, why it may not control, `ask`
-   * @param {() => boolean} live whether the page shows the live machine (its stream live, not looking back)
    */
-  constructor(store, controls, live) {
+  constructor(store, controls) {
     this.store = store;
     this.controls = controls;
-    this.live = live;
     $("pause-btn").addEventListener("click", () => controls.ask("Pause", api.pause));
     $("resume-btn").addEventListener("click", () => controls.ask("Resume", api.resume));
     $("step-btn").addEventListener("click", () => controls.ask("Step", api.step));
@@ -44,19 +43,19 @@ export class DebugBar {
     });
   }
 
-  /** Show the debugger's state of `shown` (the status of the instant shown; null: no machine) and
-   * enable what the live machine accepts now. */
-  update(shown) {
-    const text = pausedText(shown?.debug);
+  /** Show the debugger's state at the instant shown of `state` (the store's) and enable what the live
+   * machine accepts now. */
+  update(state) {
+    const text = pausedText(shownStatus(state)?.debug);
     const bar = $("debug-bar");
     bar.hidden = text === null;
     const what = bar.querySelector(".debug-text");
     if (text !== null) setText(what, text);
-    const now = this.store.status?.debug ?? { mode: "run", holds: [] };
+    const now = state.live?.debug ?? { mode: "run", holds: [] };
     const paused = now.mode !== "run" || now.holds.length > 0;
-    const can = this.live() && !this.controls.refusal();
+    const can = showsLive(state) && !this.controls.refusal();
     const enabled = {
-      "pause-btn": !paused && Boolean(this.store.status?.running),
+      "pause-btn": !paused && Boolean(state.live?.running),
       "resume-btn": paused,
       "step-btn": paused,
       "step-over-btn": now.holds.length > 0,
@@ -69,21 +68,21 @@ export class DebugBar {
   }
 
   _holds() {
-    return this.store.status?.debug?.holds ?? [];
+    return this.store.state.live?.debug?.holds ?? [];
   }
 
   /** The states whose outcome may be forced: the held ones, or, when none holds, the active leaves. */
   _forceTargets() {
-    const status = this.store.status;
+    const status = this.store.state.live;
     if (!status?.running) return [];
     const held = this._holds().map((hold) => hold.path + "/" + hold.state);
-    return (held.length ? held : status.activeLeaves()).filter((path) => this.store.nodes.get(path)?.outcomes.length);
+    return (held.length ? held : status.activeLeaves()).filter((path) => this.store.state.nodes.get(path)?.outcomes.length);
   }
 
   /** An item per registered outcome of each of those states. */
   _forceItems() {
     return this._forceTargets().flatMap((path) => {
-      const node = this.store.nodes.get(path);
+      const node = this.store.state.nodes.get(path);
       return node.outcomes.map((outcome) => ({
         label: `${node.label} → ${outcome}`, title: path,
         action: () => this.controls.ask(`Force '${outcome}' of ${path}`, (name) => api.force(name, path, outcome)),

@@ -18,3 +18,23 @@ export function writeLink(name, seq) {
   const hash = "#" + params.toString();
   if (location.hash !== hash) history.replaceState(null, "", hash);
 }
+
+const FOLLOW_MS = 250; // browsers throttle replaceState: the address follows the page at most this often
+
+/** The address following what the page's store (store.js) shows: the machine, the instant looked at. */
+export class LinkFollower {
+  constructor(store) {
+    this.store = store;
+    this.timer = null;
+  }
+
+  /** Name what the store shows now, in at most FOLLOW_MS. */
+  update() {
+    if (this.timer) return;
+    this.timer = setTimeout(() => {
+      this.timer = null;
+      const { name, instant } = this.store.state;
+      if (name !== null) writeLink(name, instant.past ? instant.status.last_seq : null);
+    }, FOLLOW_MS);
+  }
+}

@@ -9,7 +9,7 @@ import { containers, parentPath } from "./status.js";
 export class Depth {
   /**
    * @param {HTMLSelectElement} select the depth selector
-   * @param {Store} store the machine shown (store.js)
+   * @param {Store} store the page's store (store.js): the machine shown
    * @param {() => string[]} drawnOpen the containers the graph shown draws open
    * @param {(semantic: boolean) => Promise<unknown>} changed called when another set of containers is
    *   to be drawn open (`semantic`: by semantic zoom, as the machine moves); resolves when it is drawn
@@ -45,11 +45,11 @@ export class Depth {
 
   /** A drawing is in: under "auto", one that leaves containers closed turns semantic zoom on. */
   laidOut() {
-    if (!this.anyOpenSet || this.expand || this.semanticOn || !this.store.status.structure) return;
-    const all = [...containers(this.store.status.structure)].length;
+    if (!this.anyOpenSet || this.expand || this.semanticOn || !this.store.state.live.structure) return;
+    const all = [...containers(this.store.state.live.structure)].length;
     if (this.drawnOpen().length >= all) return;
     this.semanticOn = true;
-    this.semantic.reset(this.store.status.root_path);
+    this.semantic.reset(this.store.state.live.root_path);
   }
 
   /** The instant shown (its running containers, the selection): semantic zoom follows it. */
@@ -59,11 +59,11 @@ export class Depth {
 
   /** A new structure: forget the containers it no longer has, offer one depth per level of them. */
   restructured() {
-    const nodes = this.store.nodes;
+    const nodes = this.store.state.nodes;
     this.semanticOn = false;
     this.semantic.reset(null);
     if (this.expand) this.expand = new Set([...this.expand].filter((p) => nodes.has(p)));
-    const max = [...containers(this.store.status.structure)].reduce((m, n) => Math.max(m, this._depthOf(n.path) + 1), 1);
+    const max = [...containers(this.store.state.live.structure)].reduce((m, n) => Math.max(m, this._depthOf(n.path) + 1), 1);
     const current = this.select.value;
     const values = ["auto", ...Array.from({ length: max }, (_, i) => String(i + 1)), "custom"];
     this.select.replaceChildren(...values.map((value) => h("option", { value, text: value, hidden: value === "custom" })));
@@ -75,9 +75,9 @@ export class Depth {
   reveal(path) {
     const open = new Set(this.drawnOpen());
     const needed = [];
-    for (let p = parentPath(path); p; p = parentPath(p)) if (!open.has(p) && this.store.nodes.has(p)) needed.push(p);
+    for (let p = parentPath(path); p; p = parentPath(p)) if (!open.has(p) && this.store.state.nodes.has(p)) needed.push(p);
     if (!needed.length) return Promise.resolve();
-    if (!this.expand) this.expand = new Set([...open, this.store.status.root_path]);
+    if (!this.expand) this.expand = new Set([...open, this.store.state.live.root_path]);
     for (const p of needed) this.expand.add(p);
     this.select.value = "custom";
     return Promise.resolve(this.changed(false));
@@ -85,8 +85,8 @@ export class Depth {
 
   /** Open the container at `path` or close it (`isCluster`: it is drawn open). */
   toggle(path, isCluster) {
-    const root = this.store.status.root_path;
-    const node = this.store.nodes.get(path);
+    const root = this.store.state.live.root_path;
+    const node = this.store.state.nodes.get(path);
     if (!node || !node.container || path === root) return;
     if (!this.expand) {
       // From the server's default: open what it opened.
@@ -105,16 +105,16 @@ export class Depth {
   _chosen(value) {
     if (value === "auto") {
       this.expand = null;
-      if (this.semanticOn) this.semantic.reset(this.store.status.root_path);
+      if (this.semanticOn) this.semantic.reset(this.store.state.live.root_path);
     } else if (value !== "custom") {
       const d = Number(value);
-      this.expand = new Set([...containers(this.store.status.structure)].map((n) => n.path).filter((p) => this._depthOf(p) < d));
+      this.expand = new Set([...containers(this.store.state.live.structure)].map((n) => n.path).filter((p) => this._depthOf(p) < d));
     }
     this.changed(false);
   }
 
   _depthOf(path) {
-    const root = this.store.status.root_path || "";
+    const root = this.store.state.live.root_path || "";
     return path === root ? 0 : path.slice(root.length).split("/").length - 1;
   }
 }

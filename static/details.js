@@ -35,7 +35,7 @@ function rows(pairs) {
 export class DetailsPanel {
   /**
    * @param {HTMLDetailsElement} section the collapsible section (its `.details-body` is filled)
-   * @param {Store} store the machine shown (its nodes and selection)
+   * @param {Store} store the page's store (store.js): the machine shown
    * @param {object} api the REST API (api.js): `summary(name, path)`
    */
   constructor(section, store, api) {
@@ -51,19 +51,18 @@ export class DetailsPanel {
     setInterval(() => this.poll(), POLL_MS);
   }
 
-  /** Show the selection of the store (rebuilt only when it or the structure changed). */
-  update() {
-    const path = this.store.selected;
-    if (path === this.path && this.store.structureKey === this.structureKey) return;
+  /** Show the selection of `state` (the store's; rebuilt only when it or the structure changed). */
+  update({ selected: path, structureKey, nodes }) {
+    if (path === this.path && structureKey === this.structureKey) return;
     this.path = path;
-    this.structureKey = this.store.structureKey;
-    const node = path ? this.store.nodes.get(path) : null;
+    this.structureKey = structureKey;
+    const node = path ? nodes.get(path) : null;
     if (!node) {
       this.stats = null;
       this.body.replaceChildren(h("p", { class: "empty", text: "Select a state or container (or search: Ctrl-K)." }));
       return;
     }
-    const parentNode = this.store.nodes.get(parentPath(path)) || null;
+    const parentNode = nodes.get(parentPath(path)) || null;
     this.stats = h("div", { class: "details-stats" }, h("p", { class: "muted", text: "counting…" }));
     this.body.replaceChildren(
       h("p", { class: "details-head" }, h("strong", { text: node.label }), " ", h("span", { class: "muted", text: node.type })),
@@ -105,12 +104,12 @@ export class DetailsPanel {
   /** Ask the server for the statistics of the state shown, while the section is open (one request at a time). */
   async poll() {
     const path = this.path;
-    const name = this.store.name;
+    const name = this.store.state.name;
     if (!this.section.open || !path || !this.stats || this.asking || document.hidden) return;
     this.asking = true;
     try {
       const answer = await this.api.summary(name, path);
-      if (path === this.path && name === this.store.name) this._showStats(answer, path);
+      if (path === this.path && name === this.store.state.name) this._showStats(answer, path);
     } catch (err) {
       if (path === this.path) this.stats.replaceChildren(h("p", { class: "muted", text: "No statistics: " + (err.detail || err.message) }));
     } finally {

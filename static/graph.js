@@ -6,15 +6,17 @@
 // at the scale shown: a pan (drag, Follow) moves the stage (a CSS transform, which Chromium composites
 // without laying out or painting the drawing again: changing the viewBox of a 600-state drawing laid
 // its text out again, 15 ms a frame), a zoom resizes it. `vb`, the view box shown, is the one
-// abstraction the rest of the page reads. A fit keeps labels readable (graph_geometry.js), a new layout of the same machine
-// can keep one element where it was on screen (semantic zoom). It tells its host what changed
-// ("graph:layout", "graph:view", "graph:focus", "graph:fit" events), which the minimap and the
-// breadcrumb (minimap.js, breadcrumb.js) follow. One module (about 360 lines): loading, marking and pan/zoom all
-// act on the same inlined SVG and its element index.
+// abstraction the rest of the page reads. A fit keeps labels readable (graph_geometry.js), a new
+// layout of the same machine can keep one element where it was on screen (semantic zoom). It tells
+// its host what changed ("graph:layout", "graph:view", "graph:focus", "graph:fit" events), which the
+// minimap and the breadcrumb (minimap.js, breadcrumb.js) follow; its pointer is graph_pointer.js's.
+// One piece on purpose: loading, marking and the view box all act on the same inlined SVG, its
+// element index and the boxes measured on it.
 
 import { anchorAfter, anchorBefore, readableFit } from "./graph_fit.js";
 import { COMFORT_SCALE, READABLE_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox, viewAt } from "./graph_geometry.js";
 import { GraphMarks } from "./graph_marks.js";
+import { bindPointer } from "./graph_pointer.js";
 import { markExactly } from "./dom.js";
 import { containerId, outcomeId, stateId } from "./schema.js";
 import { parentPath } from "./status.js";
@@ -29,7 +31,6 @@ export class GraphView {
    */
   constructor(host, handlers) {
     this.host = host;
-    this.handlers = handlers;
     this.svg = null;
     this.marks = null; // the overlay that draws the classes set on this.svg's elements
     this.base = null; // the layout's own viewBox {x, y, w, h}
@@ -48,9 +49,9 @@ export class GraphView {
     this.boxes = new Map(); // element id -> its box in user space (measured once per drawing)
     new ResizeObserver(() => {
       this.size = null;
-      if (this.vb) this._setViewBox(this.vb);
+      if (this.vb) this.setViewBox(this.vb);
     }).observe(host);
-    this._bindPointer();
+    bindPointer(this, handlers);
   }
 
   _emit(type, detail) {
@@ -97,7 +98,7 @@ export class GraphView {
     this.host.replaceChildren(this.stage);
     this.clusters = clusterBoxes(svg, this.pathOf);
     const anchored = anchor ? anchorAfter(this, anchor) : null;
-    if (anchored) this._setViewBox(anchored);
+    if (anchored) this.setViewBox(anchored);
     else this.fit();
     this._emit("layout");
     return true;
@@ -186,7 +187,7 @@ export class GraphView {
     this._setClass("breakpoint", this._drawnIds(view.breakpoints));
     this._setClass("held", this._drawnIds(view.held));
     this.marks.show(new Set([...this.classed.values()].flatMap((ids) => [...ids])));
-    if (pan) this._setViewBox(pan);
+    if (pan) this.setViewBox(pan);
   }
 
   /** The ids of the elements standing for `paths` (each itself or its closest drawn ancestor). */
@@ -207,7 +208,7 @@ export class GraphView {
     if (!el || !rect || !this.vb) return;
     const box = this._box(el);
     const scale = this.scale() < READABLE_SCALE ? COMFORT_SCALE : this.scale();
-    this._setViewBox(viewAt(box.x + box.w / 2, box.y + box.h / 2, scale, rect.width, rect.height));
+    this.setViewBox(viewAt(box.x + box.w / 2, box.y + box.h / 2, scale, rect.width, rect.height));
   }
 
   /** An element's box in user space, measured once per drawing. */
@@ -267,14 +268,14 @@ export class GraphView {
     if (!this.base) return;
     const rect = this._hostSize();
     const { vb, note } = rect ? readableFit(this, rect) : { vb: { ...this.base }, note: "" };
-    this._setViewBox(vb);
+    this.setViewBox(vb);
     this._emit("fit", note);
   }
 
   /** Show `box` (user space) whole, centred, at most MAX_FIT_SCALE. */
   fitBox(box) {
     const rect = this._hostSize();
-    if (rect) this._setViewBox(fitView(box, rect.width, rect.height));
+    if (rect) this.setViewBox(fitView(box, rect.width, rect.height));
   }
 
   /** Fit the open container at `path` (its frame), or the element that stands for it. */
@@ -287,7 +288,7 @@ export class GraphView {
   /** Pan, at the same scale, so that (x, y) of user space is the view's centre. */
   centreOn(x, y) {
     if (!this.vb) return;
-    this._setViewBox({ ...this.vb, x: x - this.vb.w / 2, y: y - this.vb.h / 2 });
+    this.setViewBox({ ...this.vb, x: x - this.vb.w / 2, y: y - this.vb.h / 2 });
   }
 
   /** `steps` zoom steps in (positive) or out (negative), about the view's centre. */
@@ -310,7 +311,7 @@ export class GraphView {
     const p = this._toUser(clientX - rect.left, clientY - rect.top);
     const w = Math.min(Math.max(this.vb.w / factor, this.base.w / 50, rect.width / 8), this.base.w * 20);
     const f = w / this.vb.w;
-    this._setViewBox({ x: p.x - (p.x - this.vb.x) * f, y: p.y - (p.y - this.vb.y) * f, w, h: this.vb.h * f });
+    this.setViewBox({ x: p.x - (p.x - this.vb.x) * f, y: p.y - (p.y - this.vb.y) * f, w, h: this.vb.h * f });
   }
 
   /** The user-space point at (x, y) px from the host's top left. */
@@ -322,7 +323,7 @@ export class GraphView {
 
   /** Show `vb`: the stage resized when the scale changes (the drawing is painted again at it), else
    * only moved. */
-  _setViewBox(vb) {
+  setViewBox(vb) {
     this.vb = vb;
     const view = this.stage && this.visible();
     if (!view) return;
@@ -334,70 +335,5 @@ export class GraphView {
     }
     this.stage.style.transform = `translate(${(this.base.x - view.x) * k}px, ${(this.base.y - view.y) * k}px)`;
     this._emit("view");
-  }
-
-  _target(event) {
-    const g = event.target.closest?.("g.node, g.cluster");
-    if (!g || !this.svg?.contains(g)) return null;
-    const path = this.pathOf.get(g.id);
-    if (path === undefined) return null;
-    // A cluster or a container's outcome stands for the open container (double-click closes it).
-    return { path, cluster: g.id !== stateId(path), el: g };
-  }
-
-  _bindPointer() {
-    const host = this.host;
-    let drag = null;
-    host.addEventListener("wheel", (e) => {
-      if (!this.svg) return;
-      e.preventDefault();
-      // A wheel notch (100 px, or 3 lines) is one zoom step.
-      this.zoom(ZOOM_STEP ** (-e.deltaY / (e.deltaMode === 1 ? 3 : 100)), e.clientX, e.clientY);
-    }, { passive: false });
-    host.addEventListener("pointerdown", (e) => {
-      if (!this.svg || e.button !== 0) return;
-      drag = { x: e.clientX, y: e.clientY, vb: { ...this.vb }, k: this.scale(), moved: false };
-    });
-    host.addEventListener("pointermove", (e) => {
-      if (!drag) return;
-      const dx = e.clientX - drag.x;
-      const dy = e.clientY - drag.y;
-      if (!drag.moved && Math.hypot(dx, dy) < 4) return;
-      if (!drag.moved) {
-        drag.moved = true;
-        host.setPointerCapture(e.pointerId);
-        host.classList.add("dragging");
-        this.handlers.userPanned?.();
-      }
-      this._setViewBox({ ...drag.vb, x: drag.vb.x - dx / drag.k, y: drag.vb.y - dy / drag.k });
-    });
-    const end = (e) => {
-      if (!drag) return;
-      if (drag.moved) {
-        host.classList.remove("dragging");
-        if (host.hasPointerCapture(e.pointerId)) host.releasePointerCapture(e.pointerId);
-        // The click that follows a drag must not select anything.
-        const swallow = (ev) => { ev.stopPropagation(); };
-        host.addEventListener("click", swallow, { capture: true, once: true });
-        setTimeout(() => host.removeEventListener("click", swallow, { capture: true }), 0);
-      }
-      drag = null;
-    };
-    host.addEventListener("pointerup", end);
-    host.addEventListener("pointercancel", end);
-    host.addEventListener("click", (e) => {
-      const t = this._target(e);
-      this.handlers.select?.(t ? t.path : null);
-    });
-    host.addEventListener("dblclick", (e) => {
-      const t = this._target(e);
-      if (t) this.handlers.toggle?.(t.path, t.cluster);
-    });
-    host.addEventListener("contextmenu", (e) => {
-      const t = this._target(e);
-      if (!t) return;
-      e.preventDefault();
-      this.handlers.contextmenu?.(t.path, e.clientX, e.clientY);
-    });
   }
 }

@@ -1,27 +1,24 @@
 // Who controls the machine shown (docs/debugging.md, "One operator at a time"): the operator lease.
 // A worker (heartbeat.js) asks who holds it every second, off the main thread, and sends the
 // heartbeat while this page holds it, so a page that is closed or cut off stops beating and the
-// server's deadman acts, and a busy one does not. The pill says
-// who holds control; "Take control" takes a free lease or, confirmed, another page's.
+// server's deadman acts, and a busy one does not. Its answers go to the store (store.js), from which
+// the pill says who holds control; "Take control" takes a free lease or, confirmed, another page's.
 
 import { api } from "./api.js";
 import { clockText } from "./clocktext.js";
 import { setText } from "./dom.js";
-import { notice } from "./notice.js";
 
 const $ = (id) => document.getElementById(id);
 const BEAT_MS = 1000; // how often the worker asks (server/lease.py BEAT_EVERY: the heartbeat's period)
 
 export class Lease {
   /**
-   * @param {Store} store the machine shown (store.js)
+   * @param {Store} store the page's store (store.js): the machine shown, who holds its lease
    * @param {Controls} controls what controls it (controls.js): whether this page may
    */
   constructor(store, controls) {
     this.store = store;
     this.controls = controls;
-    this.state = null; // the last answer about the machine shown, null when unknown
-    this.name = null; // the machine shown
     this.watching = null; // the machine the worker watches (null: none)
     this.heart = null; // the worker (heartbeat.js), made when the page first watches a machine
     api.onControl((name) => { // a page's first control takes a free lease: ask at once, to start beating
@@ -31,66 +28,61 @@ export class Lease {
     $("lease-release").addEventListener("click", () => this._release());
   }
 
-  /** Follow the machine shown and whether this page may control it (call on every controls update). */
-  update() {
-    this.name = this.store.name;
-    const want = this.name && !this.controls.refusal() ? this.name : null;
-    if (want !== this.watching) {
-      this.watching = want;
-      this.state = null;
-      if (want && !this.heart) {
-        this.heart = new Worker(new URL("./heartbeat.js", import.meta.url));
-        this.heart.onmessage = (message) => this._answered(message.data);
-      }
-      this.heart?.postMessage(want ? { ...api.leaseWatch(want), every: BEAT_MS } : { lease: null });
+  /** Have the worker watch the machine shown while this page may control it (call on every change
+   * of the machine shown, the machines or the role). */
+  watch() {
+    const name = this.store.state.name;
+    const want = name && !this.controls.refusal() ? name : null;
+    if (want === this.watching) return;
+    this.watching = want;
+    if (want && !this.heart) {
+      this.heart = new Worker(new URL("./heartbeat.js", import.meta.url));
+      this.heart.onmessage = (message) => this._answered(message.data);
     }
-    this._show();
+    this.heart?.postMessage(want ? { ...api.leaseWatch(want), every: BEAT_MS } : { lease: null });
+    this.store.setLease(null);
   }
 
   /** The worker's answer: who holds the lease, or that this page lost it (taken over, or lapsed). */
   _answered({ status, body, beat }) {
-    if (status === 200) this.state = body;
+    if (status === 200) this.store.setLease(body);
     else if (status === 409 && beat) {
-      notice(`You no longer control ${this.watching}: ${body?.detail ?? "the lease is gone"}`, "warn", true);
-      this.state = null;
+      this.store.say(`You no longer control ${this.watching}: ${body?.detail ?? "the lease is gone"}`, "warn", true);
+      this.store.setLease(null);
     }
-    this._show();
   }
 
   async _take() {
-    const name = this.name;
-    const holder = this.state?.holder;
-    const takeover = Boolean(holder) && !this.state.yours;
+    const { name, lease } = this.store.state;
+    const holder = lease?.holder;
+    const takeover = Boolean(holder) && !lease.yours;
     if (takeover && !window.confirm(`${holder.client} controls ${name}. Take control over? That page loses it.`)) return;
     try {
-      this.state = await api.takeLease(name, takeover);
+      this.store.setLease(await api.takeLease(name, takeover));
       this.heart.postMessage({ now: true, yours: true }); // beat from now on
-      notice(`You control ${name}`, "ok");
+      this.store.say(`You control ${name}`, "ok");
     } catch (err) {
-      notice("Could not take control: " + (err.detail || err.message), "error", true);
+      this.store.say("Could not take control: " + (err.detail || err.message), "error", true);
     }
-    this._show();
   }
 
   async _release() {
-    const name = this.name;
+    const name = this.store.state.name;
     try {
-      this.state = await api.releaseLease(name);
+      this.store.setLease(await api.releaseLease(name));
       this.heart.postMessage({ now: true, yours: false });
-      notice(`You gave up control of ${name}`, "ok");
+      this.store.say(`You gave up control of ${name}`, "ok");
     } catch (err) {
-      notice("Could not give up control: " + (err.detail || err.message), "error", true);
+      this.store.say("Could not give up control: " + (err.detail || err.message), "error", true);
     }
-    this._show();
   }
 
-  /** The pill and the two buttons, from the last answer. */
-  _show() {
+  /** The pill and the two buttons, from who holds the lease in `state` (the store's). */
+  update({ name, lease: s }) {
     const pill = $("lease-state");
     const take = $("lease-take");
     const release = $("lease-release");
     const refusal = this.controls.refusal();
-    const s = this.state;
     pill.hidden = !s;
     take.hidden = !s || s.yours || Boolean(refusal);
     release.hidden = !s || !s.yours || Boolean(refusal);
@@ -101,13 +93,13 @@ export class Lease {
     let title;
     if (s.yours) {
       text = "you control";
-      title = `This page controls ${this.name} since ${clockText(s.holder.since)}.${deadman}`;
+      title = `This page controls ${name} since ${clockText(s.holder.since)}.${deadman}`;
     } else if (s.holder) {
       text = "controlled by page " + s.holder.page;
-      title = `${s.holder.client} controls ${this.name} since ${clockText(s.holder.since)}.`;
+      title = `${s.holder.client} controls ${name} since ${clockText(s.holder.since)}.`;
     } else {
       text = "nobody controls";
-      title = `No page controls ${this.name}: the first to use a control takes it.`;
+      title = `No page controls ${name}: the first to use a control takes it.`;
     }
     setText(pill, text);
     pill.title = title;

@@ -1,10 +1,8 @@
-// The machines the server serves (/api/machines, polled) and the picker; a machine's run state; and
+// The machines the server serves (/api/machines, polled into the store) and the picker; a machine's run state; and
 // the one place that says what a machine's source (schema.js) lets this page do with it.
 
 import { api, ApiError } from "./api.js";
 import { readLink, writeLink } from "./deeplink.js";
-import { holdChange } from "./loop.js";
-import { banner } from "./notice.js";
 import { h, setText } from "./dom.js";
 import { RUN_STATES, SOURCES, runState as schemaRunState } from "./schema.js";
 
@@ -47,37 +45,27 @@ export function showRunState(pill, s, entry) {
   pill.title = s?.error ? `${s.error.exc_type || ""} ${s.error.message || ""}`.trim() : "";
 }
 
-/** The /api/machines list, polled, and the picker that opens one of them. */
+/** The /api/machines list, polled into the store (store.js), and the picker that opens one of them. */
 export class Machines {
   /** @param {object} handlers {open(name): show that machine, polled(): after each poll, answered or not} */
   constructor(picker, store, handlers) {
     this.picker = picker;
     this.store = store;
     this.handlers = handlers;
-    this.list = [];
-    this.endings = new Map(); // name -> {seq, error} of the other machines that ended without an outcome
-    this.online = true;
     picker.addEventListener("change", () => handlers.open(picker.value));
-  }
-
-  /** The /api/machines entry of the machine shown, or null. */
-  current() {
-    return this.list.find((m) => m.name === this.store.name) || null;
   }
 
   async poll() {
     try {
       const list = await api.machines();
-      this.online = true;
-      banner("");
-      this.list = Array.isArray(list) ? list : [];
+      this.store.setBanner("");
+      this.store.setMachines(Array.isArray(list) ? list : [], true);
       this.checkEndings();
-      this.fillPicker();
       this._pick();
     } catch (err) {
-      this.online = false;
       const unauthorized = err instanceof ApiError && err.status === 401;
-      banner(unauthorized ? "Not authorized: open the address the server printed (the one with ?token=...)." : "");
+      this.store.setBanner(unauthorized ? "Not authorized: open the address the server printed (the one with ?token=...)." : "");
+      this.store.setMachines(null, false);
     } finally {
       this.handlers.polled();
       setTimeout(() => this.poll(), POLL_MS);
@@ -86,10 +74,10 @@ export class Machines {
 
   /** Open the machine the address names, else a running one, else the first, unless one is shown. */
   _pick() {
-    const name = this.store.name;
-    if (name && this.list.some((m) => m.name === name)) return;
+    const { name, machines: { list } } = this.store.state;
+    if (name && list.some((m) => m.name === name)) return;
     const wanted = readLink().machine;
-    const pick = this.list.find((m) => m.name === wanted) || this.list.find((m) => m.running) || this.list[0];
+    const pick = list.find((m) => m.name === wanted) || list.find((m) => m.running) || list[0];
     if (pick && pick.name !== name) this.handlers.open(pick.name);
   }
 
@@ -103,35 +91,25 @@ export class Machines {
   /** Whether the other machines that ended without an outcome failed: /api/machines does not say,
    * their status does (asked once per change of their last_seq). */
   checkEndings() {
-    for (const m of this.list) {
-      if (m.name === this.store.name || m.running || m.outcome || this.endings.get(m.name)?.seq === m.last_seq) continue;
+    const { name, machines: { list, endings } } = this.store.state;
+    for (const m of list) {
+      if (m.name === name || m.running || m.outcome || endings.get(m.name)?.seq === m.last_seq) continue;
       const ending = { seq: m.last_seq, error: null };
-      this.endings.set(m.name, ending);
-      api.status(m.name).then((s) => {
-        ending.error = s.error;
-        this.fillPicker();
-      }).catch(() => this.endings.delete(m.name)); // asked again at the next poll
+      this.store.setEnding(m.name, ending);
+      api.status(m.name).then((s) => this.store.setEnding(m.name, { ...ending, error: s.error }))
+        .catch(() => this.store.setEnding(m.name, null)); // asked again at the next poll
     }
   }
 
-  /** A hold seen on the stream of the machine shown: what the next poll will say of its loop. */
-  sawHold(ev) {
-    const held = holdChange(ev);
-    const entry = this.current();
-    if (held === null || !entry?.can_hold) return null;
-    entry.held = held;
-    return held;
-  }
-
-  fillPicker() {
-    const { name, status } = this.store;
+  /** The picker: each machine and its run state (the stream's, fresher, for the machine shown). */
+  update({ name, live, machines: { list, endings } }) {
     const have = [...this.picker.options].map((o) => o.value + "\u0000" + o.textContent).join("\u0001");
-    const labels = this.list.map((m) => {
-      const live = m.name === name && status?.structure
-        ? status // the stream is fresher
-        : { running: m.running, outcome: m.outcome, error: this.endings.get(m.name)?.error };
-      const state = runState(live, m);
-      const text = state === "done" ? "→ " + live.outcome : state;
+    const labels = list.map((m) => {
+      const status = m.name === name && live?.structure
+        ? live // the stream is fresher
+        : { running: m.running, outcome: m.outcome, error: endings.get(m.name)?.error };
+      const state = runState(status, m);
+      const text = state === "done" ? "→ " + status.outcome : state;
       return [m.name, `${m.name}  (${text}${m.source === SOURCES.ingest ? ", remote" : ""})`];
     });
     if (labels.map(([v, t]) => v + "\u0000" + t).join("\u0001") === have) return;

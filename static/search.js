@@ -4,18 +4,17 @@
 
 import { h } from "./dom.js";
 import { MAX_RESULTS, SearchIndex } from "./search_index.js";
+import { shownStatus } from "./shown.js";
 
 const KINDS = { state: "state", container: "container", key: "userdata key", outcome: "outcome" };
 
 export class SearchPalette {
   /**
-   * @param {Store} store the machine shown (its structure and its key)
-   * @param {() => object} status the status shown (its containers' userdata keys)
+   * @param {Store} store the page's store (store.js): the structure, the status shown (its userdata keys)
    * @param {(entry: object) => void} choose called with the chosen entry ({kind, name, path})
    */
-  constructor(store, status, choose) {
+  constructor(store, choose) {
     this.store = store;
-    this.status = status;
     this.choose = choose;
     this.index = null;
     this.indexed = null; // the structure key the index was built for
@@ -48,13 +47,13 @@ export class SearchPalette {
 
   /** Open the palette (the index built when the structure changed, the keys read from the status shown). */
   open() {
-    const root = this.store.status?.structure;
+    const root = this.store.state.live?.structure;
     if (!root) return;
-    if (this.indexed !== this.store.structureKey) {
+    if (this.indexed !== this.store.state.structureKey) {
       this.index = new SearchIndex(root);
-      this.indexed = this.store.structureKey;
+      this.indexed = this.store.state.structureKey;
     }
-    this.index.setKeys(this.status()?.containers);
+    this.index.setKeys(shownStatus(this.store.state)?.containers);
     if (!this.dialog.open) this.dialog.showModal();
     this.input.select();
     this._update();

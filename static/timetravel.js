@@ -1,9 +1,11 @@
-// The playhead: which instant of the machine shown the page draws. Live (the stream's present) or
-// an event of the past, rebuilt by the server (GET .../status?seq=N) and moved on locally with the
-// same reducer (status.js) from pages of history (GET .../history) while it plays. Seeks are
-// coalesced: one request in flight, the newest target wins, so a drag never queues up requests.
+// The playhead: which instant of the machine shown the page draws, kept in the store (store.js,
+// `state.instant`) and moved only from here. Live (the stream's present) or an event of the past,
+// rebuilt by the server (GET .../status?seq=N) and moved on locally with the same reducer
+// (status.js) from pages of history (GET .../history) while it plays. Seeks are coalesced: one
+// request in flight, the newest target wins, so a drag never queues up requests.
 
 import { Status } from "./status.js";
+import { presentOf } from "./store.js";
 
 const STEP_KINDS = "start,transition,terminate"; // what "the previous / next transition" steps over
 const WINDOW_BEFORE = 400; // events of the log shown before the instant
@@ -15,11 +17,13 @@ const WINDOW_EVERY_MS = 250; // while playing, the log around the instant is red
 export class Playhead {
   /**
    * @param {object} api {statusAt(name, {seq}|{t}), history(name, params)}: the server's answers
-   * @param {object} handlers {changed(): the instant, its status or its window changed; failed(err)}
+   * @param {Store} store the page's store: its `instant` is what this moves
+   * @param {(err: Error) => void} failed told when an instant could not be shown
    */
-  constructor(api, handlers) {
+  constructor(api, store, failed) {
     this.api = api;
-    this.handlers = handlers;
+    this.store = store;
+    this.failed = failed;
     this.speed = 1;
     this.open(null, false);
   }
@@ -27,11 +31,7 @@ export class Playhead {
   /** Show machine `name`: at event `at` when given, else live, or (a replay) paused at its first event. */
   open(name, replay, at = null) {
     this.name = name;
-    this.replay = replay;
-    this.past = false; // false: the page draws the stream's present
-    this.status = null; // the Status at the instant, when past
-    this.window = null; // {events, seq}: the log around the instant, when past
-    this.playing = false;
+    this.store.setInstant(presentOf(replay));
     this.ahead = []; // events after the instant, fetched while playing
     this.exhausted = false; // no events after `ahead` (the end of what the server has)
     this._target = null; // the newest seek asked for
@@ -41,6 +41,22 @@ export class Playhead {
     if (name === null) return;
     if (at !== null) this.seek({ seq: at });
     else if (replay) this._first();
+  }
+
+  get past() {
+    return this.store.state.instant.past;
+  }
+
+  get status() {
+    return this.store.state.instant.status;
+  }
+
+  get playing() {
+    return this.store.state.instant.playing;
+  }
+
+  get replay() {
+    return this.store.state.instant.replay;
   }
 
   get seq() {
@@ -68,10 +84,7 @@ export class Playhead {
       this._last();
       return;
     }
-    this.past = false;
-    this.status = null;
-    this.window = null;
-    this.handlers.changed();
+    this.store.setInstant({ past: false, status: null, window: null });
   }
 
   /** Step to the previous (-1) or next (+1) transition of any container, or of container `path`. */
@@ -89,35 +102,32 @@ export class Playhead {
       const next = page.events[page.events.length - 1];
       if (next) this.seek({ seq: next.seq });
     } catch (err) {
-      this.handlers.failed(err);
+      this.failed(err);
     }
   }
 
   play() {
     if (this.name === null || this.playing) return;
     if (!this.past) return; // live already moves on its own
-    this.playing = true;
     this._clock = this.t;
     this._tick = null;
     this._played = []; // events played since the log was last redrawn
     this._windowAt = 0;
+    this.store.setInstant({ playing: true });
     this._fill();
     requestAnimationFrame((now) => this._frame(now));
-    this.handlers.changed();
   }
 
   pause() {
     if (!this.playing) return;
-    this.playing = false;
     this.ahead = [];
     this.exhausted = false;
+    this.store.setInstant({ playing: false });
     this._scheduleWindow();
-    this.handlers.changed();
   }
 
   setSpeed(speed) {
     this.speed = speed;
-    this.handlers.changed();
   }
 
   /** How many events the instant is behind `liveStatus` (the stream's present). */
@@ -136,13 +146,11 @@ export class Playhead {
         this._target = null;
         const data = await this.api.statusAt(this.name, target);
         if (generation !== this._generation) return;
-        this.status = Status.fromDict({ machine: this.name, ...data });
-        this.past = true;
-        this.handlers.changed();
+        this.store.setInstant({ past: true, status: Status.fromDict({ machine: this.name, ...data }) });
       }
       if (generation === this._generation) this._scheduleWindow();
     } catch (err) {
-      if (generation === this._generation) this.handlers.failed(err);
+      if (generation === this._generation) this.failed(err);
     } finally {
       if (generation === this._generation) this._busy = false;
     }
@@ -165,7 +173,7 @@ export class Playhead {
       const ev = page.events[0];
       if (ev) this.seek({ seq: ev.seq });
     } catch (err) {
-      if (generation === this._generation) this.handlers.failed(err);
+      if (generation === this._generation) this.failed(err);
     }
   }
 
@@ -185,10 +193,9 @@ export class Playhead {
         since: Math.max(0, seq - WINDOW_BEFORE), until: seq + WINDOW_AFTER, limit: WINDOW_BEFORE + WINDOW_AFTER + 1,
       });
       if (generation !== this._generation || seq !== this.seq) return;
-      this.window = { events: page.events, seq };
-      this.handlers.changed();
+      this.store.setInstant({ window: { events: page.events, seq } });
     } catch (err) {
-      if (generation === this._generation) this.handlers.failed(err);
+      if (generation === this._generation) this.failed(err);
     }
   }
 
@@ -205,7 +212,7 @@ export class Playhead {
       this.ahead.push(...page.events);
       if (!page.more) this.exhausted = true;
     } catch (err) {
-      this.handlers.failed(err);
+      this.failed(err);
       this.pause();
     } finally {
       this._filling = false;
@@ -223,13 +230,14 @@ export class Playhead {
     while (applied < ahead.length && ahead[applied].t <= this._clock) this.status.apply(ahead[applied++]);
     if (applied) {
       this._played.push(...ahead.splice(0, applied));
+      const moved = {};
       if (now - this._windowAt >= WINDOW_EVERY_MS) { // the log follows a few times a second, not every frame
         this._windowAt = now;
-        const events = (this.window ? this.window.events.concat(this._played) : this._played).slice(-WINDOW_BEFORE);
+        const { window } = this.store.state.instant;
+        moved.window = { events: (window ? window.events.concat(this._played) : this._played).slice(-WINDOW_BEFORE), seq: this.seq };
         this._played = [];
-        this.window = { events, seq: this.seq };
       }
-      this.handlers.changed();
+      this.store.setInstant(moved); // the status moved on in place
     }
     if (ahead.length < AHEAD / 4) this._fill();
     if (!ahead.length && this.exhausted) {

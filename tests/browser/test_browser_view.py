@@ -1,4 +1,4 @@
-"""static/store.js's view(): what the graph shows (active states, running containers, outcomes
+"""static/shown.js's view(): what the graph shows (active states, running containers, outcomes
 reached, last edges, failed paths) from the events of a real run, called in the page as a pure
 function."""
 
@@ -16,11 +16,12 @@ from smach_support import failing_machine, run_to_failure
 
 # The view of a fresh page's store after `events` (a list of event dicts).
 VIEW_AFTER = """async (events) => {
-    const { Store, view } = await import('/store.js');
+    const { Store } = await import('/store.js');
+    const { view } = await import('/shown.js');
     const store = new Store();
     store.open('m');
-    for (const e of events) store.apply(e);
-    const shown = view(store.status);
+    store.apply(events);
+    const shown = view(store.state.live);
     for (const list of Object.values(shown)) list.sort();
     return shown;
 }"""

@@ -23,7 +23,7 @@ def demo_page(watched, demo):
     watched.wait_for_selector("#run-state.running")
     # A page that lost the lease to the let-go says so: wait until it knows, then clear what it said.
     watched.wait_for_function("() => document.getElementById('lease-state').textContent === 'nobody controls'")
-    watched.evaluate("async () => (await import('/notice.js')).clearNotice()")
+    watched.evaluate("() => window.fsmscope.clearNotice()")
     yield watched
     watched.keyboard.press("Escape")
 

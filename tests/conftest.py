@@ -167,9 +167,9 @@ def layer_of(item: pytest.Item) -> str | None:
 
 
 def pytest_collection_modifyitems(items):
-    """Mark every test with its layer. Under xdist (make test), the tests that drive a browser or the
-    shared demo run one after the other in one worker (one Chromium at a time on two cores), the
-    others spread over the remaining workers."""
+    """Mark every test with its layer. Under xdist (make test), the browser and demo layers run one
+    test after the other in one worker (one Chromium at a time on two cores: two at once made the
+    whole run slower, and timing tests flaky), the other layers wherever a worker is free."""
     for item in items:
         layer = layer_of(item)
         if layer is not None:

@@ -23,6 +23,7 @@ To add one, write the module and list it in ``SUBCOMMANDS``.
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from typing import Protocol
 
@@ -84,6 +85,10 @@ def main(argv: list[str] | None = None) -> int:
         parser.error("unrecognized arguments: %s" % " ".join(extra))
     _refuse_unused(parsers[args.command], args)
     args.extra = extra + passed_on
+    # Ctrl-C (SIGINT) stops every command cleanly, also when it was started with SIGINT ignored, as a
+    # non-interactive shell starts a command it puts in the background (`fsmscope serve &` in a script):
+    # Python then installs no handler of its own and the command could only be killed.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     try:
         return SUBCOMMANDS[args.command].main(args)
     except CannotServe as exc:

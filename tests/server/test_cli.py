@@ -262,6 +262,21 @@ def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, si
     assert json.loads(cli("replay", log, "--json").stdout)["problems"] == []
 
 
+def test_ctrl_c_stops_a_command_started_with_sigint_ignored(foo_bar_log):
+    # A non-interactive shell starts a command it puts in the background with SIGINT ignored.
+    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve"], cwd=ROOT,
+                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
+    try:
+        assert any("replaying" in line for line in proc.stderr)  # up to the line with its address
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
 def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_log):
     with replay_served(foo_bar_log, "--speed", "2", "--token", "replay-token") as (url, _):
         base, headers = url.split("/?")[0], {"Authorization": "Bearer replay-token"}

@@ -1,5 +1,6 @@
 // Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
 // (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
+// One piece because it is the page's copy of that one definition: constants, rules and typedefs.
 
 /** The event schema version this page reads. */
 export const SCHEMA_VERSION = 1;

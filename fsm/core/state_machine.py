@@ -1,6 +1,6 @@
 """StateMachine: one active child at a time, outcomes mapped to the next child or to a container outcome.
 
-One piece (about 300 lines) because it is SMACH's class, method for method: construction and
+One piece because it is SMACH's class, method for method: construction and
 checks, the transition step, execution, preemption and introspection all read and write the
 same current-state fields under one lock."""
 

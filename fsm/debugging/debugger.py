@@ -16,7 +16,7 @@ preempt of the holding container ends the hold (and a machine being preempted ne
 until the preempt is over). A state's own code is never interrupted: "paused" means no new
 transition, the running state runs on until it returns.
 
-One piece (about 300 lines) because the gates and the controls share one lock and one set of holds.
+One piece because the gates and the controls share one lock and one set of holds.
 """
 
 from __future__ import annotations

@@ -165,19 +165,6 @@ class Remapper:
             return
         self._ud[self._remapping.get(name, name)] = value
 
-    def track_writes(self) -> None:
-        """From now on, remember the keys written (for a reporter's ``userdata`` events)."""
-        object.__setattr__(self, "_dirty", set())
-
-    def take_written(self) -> dict | None:
-        """The keys written since the last call, with their values; None when none was."""
-        dirty = self._dirty
-        if not dirty:
-            return None
-        object.__setattr__(self, "_dirty", set())
-        data = self._data
-        return {k: data[k] for k in dirty if k in data}
-
     __getitem__ = __getattr__
     __setitem__ = __setattr__
 

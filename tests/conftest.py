@@ -167,15 +167,11 @@ def layer_of(item: pytest.Item) -> str | None:
 
 
 def pytest_collection_modifyitems(items):
-    """Mark every test with its layer. Under xdist (make test), the browser and demo layers run one
-    test after the other in one worker (one Chromium at a time on two cores: two at once made the
-    whole run slower, and timing tests flaky), the other layers wherever a worker is free."""
+    """Mark every test with its layer."""
     for item in items:
         layer = layer_of(item)
         if layer is not None:
             item.add_marker(layer)
-        if layer in ("browser", "demo"):
-            item.add_marker(pytest.mark.xdist_group("browser"))
 
 
 @pytest.fixture(autouse=True)

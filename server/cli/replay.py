@@ -187,10 +187,9 @@ def replay_in_browser(args: argparse.Namespace) -> int:
     try:
         srv = start_server(args, hub=hub, **({} if scene is None else {"scene_url": scene.url,
                                                                        "show_pose": scene.show_pose}))
-        print("fsmscope: replaying %s at %s (%d events loaded; Ctrl-C stops)" % (args.log, srv.url, count),
-              file=sys.stderr, flush=True)
         try:
-            wait_for_interrupt()
+            wait_for_interrupt("fsmscope: replaying %s at %s (%d events loaded; Ctrl-C stops)"
+                               % (args.log, srv.url, count))
         finally:
             srv.stop()
     finally:

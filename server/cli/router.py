@@ -8,7 +8,6 @@ tcp/ROUTER:7447 --zenoh-mode client``); routers of other sites are joined with `
 from __future__ import annotations
 
 import argparse
-import sys
 
 from .fleet_bridge import zenoh_config_file
 from .cannot_serve import CannotServe
@@ -40,8 +39,7 @@ def main(args: argparse.Namespace) -> int:
         session = open_session(args.connect, listen, "router", args.scouting, args.zenoh_config)
     except ValueError as exc:
         raise CannotServe(str(exc)) from None
-    print("fsmscope: routing Zenoh on %s; robots connect with --zenoh-connect ENDPOINT, dashboards with "
-          "--zenoh ENDPOINT --zenoh-mode client; Ctrl-C stops" % ", ".join(listen), file=sys.stderr, flush=True)
-    wait_for_interrupt()
+    wait_for_interrupt("fsmscope: routing Zenoh on %s; robots connect with --zenoh-connect ENDPOINT, dashboards "
+                       "with --zenoh ENDPOINT --zenoh-mode client; Ctrl-C stops" % ", ".join(listen))
     session.close()
     return 0

@@ -89,9 +89,8 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
     try:
         code = runner.run()
         if not args.exit and runner.signalled is None:
-            print("fsmscope: the script ended (exit code %d); still serving at %s (Ctrl-C stops)"
-                  % (code, srv.url), file=sys.stderr, flush=True)
-            wait_for_interrupt()
+            wait_for_interrupt("fsmscope: the script ended (exit code %d); still serving at %s (Ctrl-C stops)"
+                               % (code, srv.url))
     finally:
         srv.stop()
         runner.close()

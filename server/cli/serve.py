@@ -39,8 +39,7 @@ def main(args: argparse.Namespace) -> int:
     if args.zenoh is not None:
         print("fsmscope: the fleet overview at %s" % (srv.base_url + "/fleet" + ("?token=" + srv.token if srv.token else "")), file=sys.stderr)
     announce_viewer(args, srv)
-    print("fsmscope: other processes publish with server.publisher.Publisher(%r, %r); Ctrl-C stops"
-          % (srv.base_url, srv.token), file=sys.stderr, flush=True)
-    wait_for_interrupt()
+    wait_for_interrupt("fsmscope: other processes publish with server.publisher.Publisher(%r, %r); Ctrl-C stops"
+                       % (srv.base_url, srv.token))
     srv.stop()
     return 0

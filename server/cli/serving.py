@@ -80,8 +80,12 @@ def announce_viewer(args: argparse.Namespace, srv: ServerThread) -> None:
 SWITCH_INTERVAL = 0.0005  # s a thread may hold the GIL while another waits for it (Python's default: 5 ms)
 
 
-def wait_for_interrupt() -> None:
+def wait_for_interrupt(announcement: str) -> None:
+    """Say ``announcement`` (the line that says Ctrl-C stops) on stderr, then wait for Ctrl-C. The
+    line is written inside the wait's guard: a Ctrl-C sent as soon as it is read stops the command as
+    cleanly as one sent later."""
     try:
+        print(announcement, file=sys.stderr, flush=True)
         threading.Event().wait()
     except KeyboardInterrupt:
         pass

@@ -30,7 +30,7 @@ demo: install
 	$(VENV)/bin/fsmscope demo
 
 # One process: on two cores, xdist's workers (three, the browser and demo layers in one of them)
-# took 6:15-6:37 against about 7:30, and made timing tests fail in 2 runs of 4.
+# took 6:15-6:37 against 8:50 in one, but made timing tests fail in 2 runs of 4.
 test: install
 	$(PY) -m pytest -q
 

@@ -4,18 +4,14 @@ second machine's name the same way."""
 
 from __future__ import annotations
 
-import json
-import shutil
-import subprocess
-
 import fsm
 import pytest
 
 from fleet import keys
 from fsm.observation import names, schema
 from interop.channels import EVENTS
+from node_support import map_in_schema_js, needs_node
 from server.hub import Hub
-from server.schema_export import JS_PATH
 
 NAMES = ["picker", "pick and place", "robot:arm", "ünïcødé", "x" * 200, "", " lead", "trail ", "task#2",
          "a/b", "*", "$x", "what?", "tab\there", "bell\x07", "del\x7f", "x" * 201, "\u00a0nbsp", "😀" * 200]
@@ -63,14 +59,10 @@ def test_the_hub_makes_a_valid_name_of_an_unusable_one():
     assert Hub().add_local(_machine(), "pick/place").name == "pick_place"
 
 
-@pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
+@needs_node
 def test_the_page_takes_the_same_names_as_python():
     """static/schema.js isMachineName, generated from fsm/observation/names.py, mirrors names.is_valid."""
-    program = "import(%s).then(m => console.log(JSON.stringify(%s.map(m.isMachineName))))" % (
-        json.dumps("file://" + JS_PATH), json.dumps(NAMES))
-    done = subprocess.run(["node", "--input-type=module", "-e", program], capture_output=True, text=True, timeout=30)
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout) == [names.is_valid(n) for n in NAMES]
+    assert map_in_schema_js("n => m.isMachineName(n)", NAMES) == [names.is_valid(n) for n in NAMES]
 
 
 def test_a_robot_named_with_the_fleets_separator_is_refused_before_it_joins():

@@ -5,26 +5,17 @@ the timeline's ticks are of the kinds the page draws."""
 from __future__ import annotations
 
 import itertools
-import json
-import shutil
-import subprocess
-
-import pytest
 
 from fsm.observation import vocabularies
-from server.schema_export import JS_PATH
+from node_support import map_in_schema_js, needs_node
 from server.timeline import TimelineIndex
 
 CASES = list(itertools.product([True, False], [None, "done"], [None, {"exc_type": "E"}], [None, True, False]))
 
 
-@pytest.mark.skipif(shutil.which("node") is None, reason="node is not installed")
+@needs_node
 def test_the_page_and_the_server_give_every_status_the_same_run_state():
-    program = "import(%s).then(m => console.log(JSON.stringify(%s.map(c => m.runState(...c)))))" % (
-        json.dumps("file://" + JS_PATH), json.dumps(CASES))
-    done = subprocess.run(["node", "--input-type=module", "-e", program], capture_output=True, text=True, timeout=30)
-    assert done.returncode == 0, done.stderr
-    assert json.loads(done.stdout) == [vocabularies.run_state(*case) for case in CASES]
+    assert map_in_schema_js("c => m.runState(...c)", CASES) == [vocabularies.run_state(*case) for case in CASES]
 
 
 def test_every_run_state_is_reached():

@@ -29,14 +29,15 @@ apt:
 demo: install
 	$(VENV)/bin/fsmscope demo
 
-# One process: on two cores, xdist's workers (three, the browser and demo layers in one of them)
-# took 6:15-6:37 against 8:50 in one, but made timing tests fail in 2 runs of 4.
+# Three xdist workers on two cores (the tests wait on browsers, robots and real time more than they
+# compute): each takes a whole module at a time, the demo layer goes to one (tests/conftest.py).
+# docs/benchmarks.md has the suite's time; `pytest -q` alone runs it in one process.
 test: install
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n 3
 
 # The unit layer alone: the runtime, the logs and the formats, no server, no browser (under a minute).
 test-fast: install
-	$(PY) -m pytest -q -m unit
+	$(PY) -m pytest -q -n 3 -m unit
 
 # Every benchmark prints a table (medians) against its target; all of them take ~20 minutes.
 bench: install

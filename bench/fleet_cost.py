@@ -37,7 +37,7 @@ import fsm  # noqa: E402
 import runtime  # noqa: E402
 from fleet.robot import ZenohRobot  # noqa: E402
 from runtime import two_state_loop  # noqa: E402
-from server.cli.fleet_bridge import robot_follows  # noqa: E402
+from server.cli.zenoh_options import robot_follows  # noqa: E402
 from server.http_server import ServerThread  # noqa: E402
 from server.testing.demo_process import free_endpoint  # noqa: E402
 from table import print_table, verdict  # noqa: E402

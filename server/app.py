@@ -27,6 +27,7 @@ from .middleware import SecurityMiddleware
 from .overview import Overview
 from .routes import control, debug, history, ingest, lease, machines, overview, pages, scene, stream, timeline
 from .settings import Settings
+from .static_files import static_dir
 
 
 def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int | None = None,
@@ -61,7 +62,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     app.mount("/docs-assets", StaticFiles(directory=swagger_ui_path), name="docs-assets")  # for pages.docs
     for module in (pages, machines, overview, history, timeline, control, debug, lease, scene, stream, ingest):
         app.include_router(module.router)
-    root = pages.static_dir()
+    root = static_dir()
     if root and os.path.isdir(root):
         app.mount("/static", StaticFiles(directory=root), name="static")
         app.mount("/", StaticFiles(directory=root), name="static-root")

@@ -32,7 +32,7 @@ from fsm.observation.status import Status
 
 from . import graph
 from .hub import structure_hash
-from .routes.pages import static_dir
+from .static_files import static_dir
 from .timeline import TimelineIndex
 
 MAX_MB = 64  # default size limit of a log: the whole run goes into the page, which a browser must hold

@@ -102,7 +102,7 @@ def page_while_waiting(browser, build, name: str):
 
 def watch(browser, server, machine: str):
     """A page showing ``machine`` of ``server`` (a ServerThread) with its stream live."""
-    page = open_page(browser, server.url + "#m=" + urllib.parse.quote(machine), timeout_ms=8000)
+    page = open_page(browser, server.url + "#m=" + urllib.parse.quote(machine))
     page.wait_for_selector("#badge.live")
     assert page.input_value("#machine-picker") == machine
     return page
@@ -110,10 +110,10 @@ def watch(browser, server, machine: str):
 
 @contextlib.contextmanager
 def page_at(browser, url: str, ready: str | None = None, width: int = 1280, height: int = 800,
-            timeout_ms: int = 15000):
+            scene: bool = True):
     """A page of ``browser`` at ``url`` showing a graph (and ``ready``, a selector, when given), for a
-    test or a module; it must end without a script error, and is closed."""
-    page = open_page(browser, url, width, height, timeout_ms)
+    test or a module; it must end without a script error, and is closed. ``scene``: as open_page."""
+    page = open_page(browser, url, width, height, scene=scene)
     try:
         if ready is not None:
             page.wait_for_selector(ready)
@@ -127,7 +127,7 @@ def page_at(browser, url: str, ready: str | None = None, width: int = 1280, heig
 def watching(browser, server, machine: str, ready: str | None = None):
     """``watch``'s page (and ``ready``, a selector, shown) as ``page_at`` gives it: closed at the end,
     which it must reach without a script error."""
-    with page_at(browser, server.url + "#m=" + urllib.parse.quote(machine), "#badge.live", timeout_ms=8000) as page:
+    with page_at(browser, server.url + "#m=" + urllib.parse.quote(machine), "#badge.live") as page:
         assert page.input_value("#machine-picker") == machine
         if ready is not None:
             page.wait_for_selector(ready)
@@ -328,11 +328,12 @@ class SharedDemo:
 
 
 @contextlib.contextmanager
-def watching_demo(browser, shared_demo: SharedDemo, timeout_ms: int = 30000):
-    """A page watching the shared demo at 1600 x 900 (the 3D view beside the graph), its stream live;
-    at the end the demo is let go first (a page closed holding the lease would leave the deadman to
-    pause the machine for the next test), then the page, which must have had no script error, closed."""
-    with page_at(browser, shared_demo.process().url, "#badge.live", 1600, 900, timeout_ms) as page:
+def watching_demo(browser, shared_demo: SharedDemo, scene: bool = False):
+    """A page watching the shared demo at 1600 x 900, its stream live, the 3D view beside the graph
+    drawn only when ``scene`` (open_page says why not by default); at the end the demo is let go first
+    (a page closed holding the lease would leave the deadman to pause the machine for the next test),
+    then the page, which must have had no script error, closed."""
+    with page_at(browser, shared_demo.process().url, "#badge.live", 1600, 900, scene) as page:
         try:
             yield page
         finally:

@@ -14,6 +14,7 @@ Each folder is a layer, registered as a marker of the same name (``pytest -m uni
 Shared fixtures: captured log lines, the runtime's globals restored after every test, a live server,
 a private bus and its action servers, Debian's Chromium, and one recorded demo episode."""
 
+import itertools
 import os
 import shutil
 from pathlib import Path
@@ -143,16 +144,26 @@ def servers():
 @pytest.fixture(scope="session")
 def headless_demo_log(tmp_path_factory):
     """The log of one real-time episode of ``fsmscope demo --headless --episodes 1``, the arm's pose
-    recorded with it; recorded once for the modules that read it (none may write it)."""
+    recorded with it; recorded once for the whole run (none may write it): xdist's workers share the
+    run's temporary directory, and the first to need the log records it under a lock the others wait on."""
+    import fcntl
     import subprocess
     import sys
-    from pathlib import Path
 
-    path = tmp_path_factory.mktemp("headless-demo") / "demo.jsonl"
-    done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",
-                           "--record", str(path)], cwd=Path(__file__).resolve().parents[1],
-                          capture_output=True, text=True, timeout=240)
-    assert done.returncode == 0, done.stdout + done.stderr
+    shared = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        shared = shared.parent  # the run's directory, above each worker's own
+    path = shared / "headless-demo.jsonl"
+    with open(shared / "headless-demo.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        recorded = shared / "headless-demo.recorded"  # a worker that failed recording leaves no log behind it
+        if not recorded.exists():
+            path.unlink(missing_ok=True)
+            done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",
+                                   "--record", str(path)], cwd=TESTS.parent,
+                                  capture_output=True, text=True, timeout=240)
+            assert done.returncode == 0, done.stdout + done.stderr
+            recorded.touch()
     return path
 
 
@@ -166,12 +177,42 @@ def layer_of(item: pytest.Item) -> str | None:
     return folder if folder in LAYERS else None
 
 
-def pytest_collection_modifyitems(items):
+def pytest_itemcollected(item: pytest.Item) -> None:
     """Mark every test with its layer."""
+    layer = layer_of(item)
+    if layer is not None:
+        item.add_marker(layer)
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """The demo's tests first (its real-time episodes are the longest chain), then the modules of the
+    other layers in turns, the unit layer's last: under xdist (make test) a worker whose browser is
+    busy runs beside one that waits on a robot's network, and the short unit tests fill the end.
+    Within a layer, the modules with the most tests first (xdist's own measure of a module's length)."""
+    modules: dict[str, list[pytest.Item]] = {}
     for item in items:
-        layer = layer_of(item)
-        if layer is not None:
-            item.add_marker(layer)
+        modules.setdefault(str(item.path), []).append(item)
+    layers: dict[str | None, list[list[pytest.Item]]] = {}
+    for tests in sorted(modules.values(), key=len, reverse=True):
+        layers.setdefault(layer_of(tests[0]), []).append(tests)
+    in_turns = itertools.zip_longest(*(layers.pop(layer, []) for layer in ("browser", "fleet", "server", "parity")))
+    ordered = layers.pop("demo", []) + [tests for turn in in_turns for tests in turn if tests]
+    ordered += [tests for rest in layers.values() for tests in rest]  # the unit layer
+    items[:] = [item for tests in ordered for item in tests]
+
+
+def pytest_xdist_make_scheduler(config: pytest.Config, log):
+    """xdist (make test) sends each worker a whole module at a time (its module-scoped servers and
+    pages start once), and the whole demo layer to one worker (one demo process), in the order above."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class ModulesAndTheDemo(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            module = nodeid.split("::", 1)[0]
+            return "tests/demo" if module.startswith("tests/demo/") else module
+
+    config.option.loadscopereorder = False  # keep the order above, not the biggest module first
+    return ModulesAndTheDemo(config, log)
 
 
 @pytest.fixture(autouse=True)

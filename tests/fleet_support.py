@@ -248,4 +248,5 @@ def preempted_the_dashboard_has_the_robots_log(dash: Dashboard, robot: Robot, si
     own = [e for e in robot.events() if e["seq"] >= since]
     wait_for(lambda: dash.machines()["r1:patrol"]["last_seq"] == own[-1]["seq"], 10, what="the last event")
     seen = history(dash, "r1:patrol", since)
-    assert [(e["seq"], e["kind"]) for e in seen] == [(e["seq"], e["kind"]) for e in own], (seen[-3:], own[-3:])
+    shown, logged = [(e["seq"], e["kind"]) for e in seen], [(e["seq"], e["kind"]) for e in own]
+    assert shown == logged, "missing %r, extra %r" % (sorted(set(logged) - set(shown)), sorted(set(shown) - set(logged)))

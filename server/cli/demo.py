@@ -17,7 +17,7 @@ import threading
 import time
 from typing import Any
 
-from .fleet_bridge import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
+from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
 from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, given_of, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from .fleet_bridge import zenoh_config_file
+from .zenoh_options import zenoh_config_file
 from .cannot_serve import CannotServe
 from .serving import wait_for_interrupt
 

@@ -7,7 +7,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .fleet_bridge import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
+from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
 from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, given_of, start_server,
                       wait_for_interrupt)
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 import sys
 
-from .fleet_bridge import ZENOH_OPTIONS, add_zenoh_arguments
+from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments
 from .cannot_serve import CannotServe
 from .serving import add_server_arguments, announce_viewer, given_of, start_server, wait_for_interrupt
 

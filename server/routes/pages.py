@@ -3,7 +3,6 @@ and where the 3D view is."""
 
 from __future__ import annotations
 
-import importlib.util
 import os
 
 from typing import Annotated
@@ -14,6 +13,7 @@ from fastapi.responses import FileResponse, HTMLResponse, Response
 
 from .. import models
 from ..auth import require_token
+from ..static_files import static_dir
 from .deps import AUTH, ERRORS
 
 router = APIRouter()
@@ -21,14 +21,6 @@ router = APIRouter()
 _PLACEHOLDER = ("<!doctype html><meta charset=utf-8><title>fsmscope</title>"
                 "<p>fsmscope server is running; the dashboard (static/index.html) is not installed. "
                 "See <a href=/docs>/docs</a>.</p>")
-
-
-def static_dir() -> str | None:
-    """Where the dashboard's files are (the ``static`` package), or None when it is not installed."""
-    spec = importlib.util.find_spec("static")
-    if spec is None or not spec.submodule_search_locations:
-        return None
-    return list(spec.submodule_search_locations)[0]
 
 
 def _page(filename: str) -> Response:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 from browser_support import ACTIVE_LEAF, filter_log
+from server.testing.browser import PAGE_WAIT_MS
 from server.testing.demo_process import free_port
 from server.testing.polling import wait_for
 
@@ -143,7 +144,7 @@ def page(browser, server):
         server.start()
     context = browser.new_context(viewport={"width": 1280, "height": 800})
     page = context.new_page()
-    page.set_default_timeout(6000)
+    page.set_default_timeout(PAGE_WAIT_MS)
     page.dialogs = []
     page.on("dialog", lambda d: (page.dialogs.append(d.message), d.dismiss()))
     page.errors = []
@@ -296,7 +297,11 @@ def test_preempt_then_start(page, server):
     page.wait_for_selector("#notice:has-text('Start ')", timeout=15000)
     assert "Start accepted" in page.text_content("#notice"), page.text_content("#notice")
     page.wait_for_selector("#run-state.running", timeout=15000)
-    page.wait_for_selector("#graph g.node.active")
+    wait_for(lambda: page.locator("#graph g.node.active").count(), 30, interval=0.1,
+             what=lambda: "a state lit in the new run; the page shows %r" % page.evaluate(
+                 "({badge: document.getElementById('badge').className, run: window.fsmscope.status.run,"
+                 " active: Object.values(window.fsmscope.status.toDict().containers).map((c) => c.active),"
+                 " lit: document.querySelectorAll('#graph .active').length})"))
 
 
 def test_page_recovers_when_the_server_restarts(page, server):

@@ -16,7 +16,7 @@ from fsm.logfiles.log_reader import seek
 from fsm.observation.schema import state_id
 from server import export_html
 from server.testing.big_machine import big_machine
-from server.testing.browser import open_page
+from server.testing.browser import PAGE_WAIT_MS, open_page
 from server.testing.polling import wait_for
 
 
@@ -29,7 +29,7 @@ def open_file(browser, path, seq: int):
     """The exported page at event ``seq`` (its deep link), every request that is not file: or data: aborted
     (``page.blocked`` lists them), the page's policy violations in ``window.violations``."""
     page = browser.new_page(viewport={"width": 1280, "height": 800})
-    page.set_default_timeout(10000)
+    page.set_default_timeout(PAGE_WAIT_MS)
     page.errors, page.blocked = [], []
     page.on("pageerror", lambda e: page.errors.append(str(e)))
 

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import pytest
 from fleet_support import Dashboard, Robot
+from server.testing.browser import PAGE_WAIT_MS
 
 
 TOKEN = "fleet-token"
@@ -33,7 +34,7 @@ def fleet(tmp_path_factory):
 def overview(browser, fleet):
     dash, robots = fleet
     page = browser.new_page(viewport={"width": 1280, "height": 800})
-    page.set_default_timeout(15000)
+    page.set_default_timeout(PAGE_WAIT_MS)
     errors: list[str] = []
     page.on("pageerror", lambda e: errors.append(str(e)))
     page.goto("%s/fleet?token=%s" % (dash.base, dash.token))

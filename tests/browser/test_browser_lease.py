@@ -99,7 +99,7 @@ def test_killing_the_operators_page_pauses_the_demo_within_the_deadman_time(brow
         http = httpx.Client(base_url="http://127.0.0.1:%d" % demo.port,
                             headers={"Authorization": "Bearer " + demo.token}, timeout=10)
         name = http.get("/api/machines").json()[0]["name"]
-        page = open_page(browser, demo.url, 1400, 900, timeout_ms=20000)
+        page = open_page(browser, demo.url, 1400, 900, scene=False)
         page.wait_for_selector(LEASE_PILL + ":not([hidden])")
         wait_for(lambda: http.get("/api/machines/%s/status" % name).json()["running"], timeout=30)
         page.click("#lease-take")

@@ -44,7 +44,7 @@ def replayed(headless_demo_log):
 def open_at(browser, srv, seq=None):
     """The dashboard on the replayed machine (at event ``seq`` through the address, when given)."""
     link = "#m=" + MACHINE + ("" if seq is None else "&seq=%d" % seq)
-    page = open_page(browser, srv.url + link)
+    page = open_page(browser, srv.url + link, scene=False)
     if seq is not None:
         shown_at(page, seq)
     return page

@@ -10,6 +10,7 @@ import threading
 import pytest
 
 from server.http_server import ServerThread
+from server.testing.browser import PAGE_WAIT_MS
 from server_support import two_state_machine
 
 
@@ -53,7 +54,7 @@ def two_dashboards():
 
 def open_dashboard(context, srv):
     page = context.new_page()
-    page.set_default_timeout(10000)
+    page.set_default_timeout(PAGE_WAIT_MS)
     page.goto(srv.url)
     page.wait_for_selector("#badge.live")
     return page

@@ -18,8 +18,8 @@ def is_arm_orange(r: int, g: int, b: int) -> bool:
 
 @pytest.fixture(scope="module")
 def page(browser, shared_demo):
-    """The shared demo, watched (its tests only look)."""
-    with watching_demo(browser, shared_demo, timeout_ms=20000) as page:
+    """The shared demo, watched with its 3D view (its tests only look)."""
+    with watching_demo(browser, shared_demo, scene=True) as page:
         yield page
 
 

@@ -11,7 +11,7 @@ from browser_support import watching_demo, wait_for_a_fresh_episode as fresh_epi
 @pytest.fixture(scope="module")
 def watched(browser, shared_demo):
     """The shared demo at real time (episodes of several seconds, a pause of 1 s between them), watched."""
-    with watching_demo(browser, shared_demo, timeout_ms=60000) as page:
+    with watching_demo(browser, shared_demo) as page:
         yield page
 
 

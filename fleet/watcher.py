@@ -24,7 +24,9 @@ machines, asking their state and history without the lock: a machine that answer
 stranger's token that nobody answers for, never holds up the events of the others. Events of a
 machine whose token was never seen are skipped (anyone on the network can put on these keys: asking
 for each would let one put a second stop the dashboard for five); those of a machine alive but not
-joined yet ask its join again, at most once per ``JOIN_AGAIN``.
+joined yet ask its join again, at most once per ``JOIN_AGAIN``, and are asked for from its history
+once it is joined (they may be its run's last: nothing would follow them to show the gap). A new
+process's events wait for its join too: its seqs count from 1 again.
 
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
 sends a control to the machine's robot (fleet/control.py). The watcher's liveliness token
@@ -79,6 +81,7 @@ class FleetWatcher:
         self._lock = threading.Lock()  # one sample or join applied at a time, by any of the threads
         self._alive: set[str] = set()  # machines whose liveliness token is up
         self._asked: dict[str, float] = {}  # machine -> when its join was last asked for
+        self._skipped: set[str] = set()  # machines whose events came while their join was on its way
         self._joins: queue.SimpleQueue[str | None] = queue.SimpleQueue()  # machine keys to join; None: stop
         self.gaps_filled = 0
         self.snapshots = 0
@@ -182,7 +185,9 @@ class FleetWatcher:
             if name not in self._last:  # not joined (yet: its token came, its join is on its way)
                 if name not in self._alive:
                     self.unannounced += 1
-                elif monotonic() - self._asked.get(name, 0.0) >= JOIN_AGAIN:  # its state did not answer
+                    return
+                self._skipped.add(name)  # asked for once the join is done: they may be the run's last
+                if monotonic() - self._asked.get(name, 0.0) >= JOIN_AGAIN:  # its state did not answer
                     self._ask_join(name, keys.machine_key(robot, machine))
                 return
             events = loads(sample.payload.to_bytes())
@@ -221,12 +226,17 @@ class FleetWatcher:
         with self._lock:
             back = name in self._last and answer["origin"] == self._origins.get(name)
             since = self._last[name] + 1 if back else 1
+            if not back:  # a new process counts from 1 again: its events wait for the join, not the old seq
+                self._last.pop(name, None)
         history = self._history(robot, machine, since)
         with self._lock:
             if back:
                 self._filled(name, history, lambda: answer)
             else:
                 self._take(name, answer, history)
+            if name in self._skipped and name in self._last:  # what came after the answers
+                self._skipped.discard(name)
+                self._fill(robot, machine, self._last[name] + 1)
 
     def _take(self, name: str, answer: dict, history: dict | None) -> None:
         """A machine new to this watcher (or its robot's process is): every event from its first when

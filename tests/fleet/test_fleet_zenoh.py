@@ -150,6 +150,45 @@ def test_a_robot_back_as_a_new_process_is_shown_from_a_new_snapshot(quiet):
         dash.watcher.close()
 
 
+def gated_machine(gate: threading.Event) -> fsm.StateMachine:
+    """FIRST, then WAIT until ``gate`` is set, then LAST: done."""
+    sm = fsm.StateMachine(["done"])
+    with sm:
+        fsm.StateMachine.add("FIRST", fsm.CBState(lambda ud: "go", outcomes=["go"]), {"go": "WAIT"})
+        fsm.StateMachine.add("WAIT", fsm.CBState(lambda ud: gate.wait(10) and "go", outcomes=["go"]), {"go": "LAST"})
+        fsm.StateMachine.add("LAST", fsm.CBState(lambda ud: "done", outcomes=["done"]), {"done": "done"})
+    return sm
+
+
+def test_the_last_events_of_a_run_put_while_the_dashboard_joins_reach_it(quiet):
+    """Put after the robot answered the join's history, before the join is applied: nothing follows
+    them to show the gap, so the join asks for them itself."""
+    endpoint = free_endpoint()
+    gate = threading.Event()
+    with ZenohRobot("r1", listen=[endpoint]) as robot:
+        own, runner = run_published(robot, gated_machine(gate))
+        wait_for(lambda: own and own[-1]["kind"] == "transition" and own[-1]["to"] == "WAIT", 10,
+                 what="the machine waiting at its gate")
+        robot.flush()
+        dash = Dashboard(connect=[endpoint])
+        answered = dash.watcher._history
+
+        def history_then_the_runs_end(*query):
+            answer = answered(*query)
+            gate.set()  # the machine ends now, its last events on their way while the join is applied
+            runner.join(10)
+            robot.flush()
+            time.sleep(0.5)
+            return answer
+
+        dash.watcher._history = history_then_the_runs_end
+        try:
+            wait_for(lambda: dash.status("r1:loop").last_seq == own[-1]["seq"], 10,
+                     what=lambda: "the run's end: %r" % [(e["kind"], e["seq"]) for e in dash.events[-3:]])
+        finally:
+            dash.watcher.close()
+
+
 def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quiet):
     endpoint = free_endpoint()
     dash = Dashboard(listen=[endpoint])

@@ -3,7 +3,7 @@ folder that needs it and stops after the folder's last test (a package-scoped fi
 runs, and costs CPU, behind the tests of the other layers."""
 
 import pytest
-from browser_support import SharedDemo
+from demo_support import SharedDemo
 
 
 @pytest.fixture(scope="package")

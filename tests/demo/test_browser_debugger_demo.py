@@ -8,7 +8,8 @@ from __future__ import annotations
 import time
 
 import pytest
-from browser_support import DEMO_MACHINE, as_page, banner_saying, demo_client, watching_demo
+from browser_support import as_page, banner_saying
+from demo_support import DEMO_MACHINE, demo_client, watching_demo
 
 LIFT = "/SM_ROOT/TASK/PICK/LIFT"  # the arm rises with the cube: it moves the moment LIFT runs
 WHEN = "attempts >= 1"

@@ -6,7 +6,8 @@ from __future__ import annotations
 import io
 
 import pytest
-from browser_support import ACTIVE_LEAF, watching_demo
+from browser_support import ACTIVE_LEAF
+from demo_support import watching_demo
 from server.testing.polling import wait_for
 
 # The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay

@@ -5,7 +5,7 @@ holds the loop (the server accepts it) and the page says so, not that it failed.
 from __future__ import annotations
 
 import pytest
-from browser_support import watching_demo, wait_for_a_fresh_episode as fresh_episode
+from demo_support import watching_demo, wait_for_a_fresh_episode as fresh_episode
 
 
 @pytest.fixture(scope="module")

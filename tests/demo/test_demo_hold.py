@@ -8,7 +8,7 @@ from __future__ import annotations
 import time
 
 import pytest
-from browser_support import wait_for_a_fresh_episode
+from demo_support import wait_for_a_fresh_episode
 
 from .test_demo_process import api, wait_for_machine
 

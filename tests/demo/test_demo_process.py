@@ -12,7 +12,8 @@ import sys
 import time
 
 import pytest
-from browser_support import ROOT, wait_for_a_fresh_episode
+from browser_support import ROOT
+from demo_support import wait_for_a_fresh_episode
 from server.testing.polling import wait_for
 
 FSMSCOPE = [sys.executable, "-m", "server.cli"]

@@ -8,7 +8,8 @@ it delivers them all (a dashboard that joins late, or restarted, sees the whole 
 state's snapshot; then it delivers the machine's events from ``.../events`` in seq order. An event
 beyond the next one expected (batches were lost while the network was down) makes it ask
 ``.../history?since=`` for the missing ones first; when the robot no longer keeps them, it takes a
-new snapshot instead. A token withdrawn (the robot's process ended, or dropped off the network past
+new snapshot instead; when the robot does not answer in time, the batch waits with the others
+skipped for the machine's join to be asked again: a gap is filled or snapshotted, never jumped. A token withdrawn (the robot's process ended, or dropped off the network past
 Zenoh's lease) is delivered as ``gone``; when it comes back, so does the machine: with the events it
 missed when its process is the same (its session's id, which the state answer carries), taken
 again (from its first event, or a snapshot) when the process is a new one (its seqs start again).
@@ -193,6 +194,11 @@ class FleetWatcher:
             events = loads(sample.payload.to_bytes())
             if events and events[0]["seq"] > self._last[name] + 1:
                 self._fill(robot, machine, self._last[name] + 1)
+                if events[0]["seq"] > self._last[name] + 1:  # the robot did not answer in time: never past a gap
+                    self._skipped.add(name)
+                    if monotonic() - self._asked.get(name, 0.0) >= JOIN_AGAIN:  # its join asks again, unlocked
+                        self._ask_join(name, keys.machine_key(robot, machine))
+                    return
             self._deliver(name, events)
 
     def _deliver(self, name: str, events: list[dict]) -> None:

@@ -215,6 +215,40 @@ def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quie
         dash.watcher.close()
 
 
+def test_a_gap_whose_history_the_robot_did_not_answer_in_time_is_filled_later_not_jumped(quiet):
+    endpoint = free_endpoint()
+    dash = Dashboard(listen=[endpoint])
+    proxy = Proxy(endpoint)
+    robot = ZenohRobot("r1", connect=[proxy.endpoint])
+    answered, unanswered = dash.watcher._history, []
+
+    def first_two_unanswered(*query):
+        if len(unanswered) < 2:  # a robot (or a network) too slow for QUERY_TIMEOUT
+            unanswered.append(query)
+            return None
+        return answered(*query)
+
+    try:
+        sm = slow_loop(300, 0.01)
+        own: list[dict] = []
+        runner = threading.Thread(target=lambda: own.extend(run_on(robot, sm)), daemon=True)
+        runner.start()
+        wait_for(lambda: len(dash.events) > 20, 10, what="events before the cut")
+        dash.watcher._history = first_two_unanswered
+        proxy.cut()
+        time.sleep(1.0)  # the machine runs on, unseen
+        proxy.restore()
+        runner.join(30)
+        wait_for(lambda: dash.events[-1]["seq"] == own[-1]["seq"], 20, what="the last event after the cut")
+        first = dash.events[0]["seq"]
+        assert len(unanswered) == 2
+        assert [e["seq"] for e in dash.events[1:]] == [e["seq"] for e in own if e["seq"] > first]
+    finally:
+        robot.close()
+        proxy.close()
+        dash.watcher.close()
+
+
 def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answers_from_its_status(quiet):
     """As `fsmscope run --zenoh` composes it (the hub is the host): the robot observes nothing itself."""
     endpoint = free_endpoint()

@@ -203,6 +203,7 @@ class MachineHandle:
             for target, states, userdata in pending:
                 self._apply(target, states, userdata)
             self.held = False
+            recall_every_preempt(self.machine)
             seq = self.emit_control("start", client, "accepted")
             if self.starter is not None:
                 try:
@@ -234,3 +235,11 @@ class MachineHandle:
         if thread is not None:
             thread.join(timeout)
 
+
+def recall_every_preempt(state: Any) -> None:
+    """Clear the preempts a run left behind: one asked of a state just as it returned is never serviced
+    (SMACH keeps it), and the next run Start begins would end 'preempted' at that state at once. A
+    container (SMACH's API: ``get_children``) and each of its states, all the way down."""
+    state.recall_preempt()
+    for child in state.get_children().values() if hasattr(state, "get_children") else ():
+        recall_every_preempt(child)

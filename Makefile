@@ -29,11 +29,11 @@ apt:
 demo: install
 	$(VENV)/bin/fsmscope demo
 
-# Four xdist workers on two cores (the tests wait on browsers, robots and real time more than they
+# Three xdist workers on two cores (the tests wait on browsers, robots and real time more than they
 # compute): each takes a whole module at a time, the demo layer goes to one (tests/conftest.py).
 # docs/benchmarks.md has the suite's time; `pytest -q` alone runs it in one process.
 test: install
-	$(PY) -m pytest -q -n 4
+	$(PY) -m pytest -q -n 3
 
 # The unit layer alone: the runtime, the logs and the formats, no server, no browser (under a minute).
 test-fast: install

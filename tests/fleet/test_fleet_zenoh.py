@@ -336,9 +336,10 @@ def test_a_put_that_is_not_a_robots_is_counted_and_the_watcher_follows_on(follow
 
 def test_events_put_for_a_machine_that_never_announced_itself_are_skipped_at_once(followed):
     dash, stranger, _ = followed
+    before = dash.watcher.unannounced  # r1's first events may have come before its token did
     stranger.put("fsmscope/ghost/m/events", b'[{"seq": 7}]')
     still_followed(dash)
-    assert dash.watcher.unannounced == 1
+    assert dash.watcher.unannounced == before + 1
     assert not any(event["machine"] == "ghost:m" for event in dash.events)
 
 

@@ -5,8 +5,10 @@ while the machine runs leaves no gap."""
 
 from __future__ import annotations
 
+import contextlib
 import threading
 import time
+from typing import Callable
 
 import fsm
 import pytest
@@ -189,7 +191,11 @@ def test_the_last_events_of_a_run_put_while_the_dashboard_joins_reach_it(quiet):
             dash.watcher.close()
 
 
-def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quiet):
+@contextlib.contextmanager
+def a_run_cut_for_a_second(before_the_cut: Callable[[Dashboard], None] = lambda dash: None):
+    """r1's machine (300 ticks of 10 ms) followed by a dashboard whose connection to it is cut for 1 s
+    once 20 events came (``before_the_cut(dash)`` is called then), and restored: yields the dashboard
+    and the robot's own events once the dashboard has the run's last one."""
     endpoint = free_endpoint()
     dash = Dashboard(listen=[endpoint])
     proxy = Proxy(endpoint)
@@ -200,53 +206,47 @@ def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quie
         runner = threading.Thread(target=lambda: own.extend(run_on(robot, sm)), daemon=True)
         runner.start()
         wait_for(lambda: len(dash.events) > 20, 10, what="events before the cut")
+        before_the_cut(dash)
         proxy.cut()
         time.sleep(1.0)  # the machine runs on, unseen
         proxy.restore()
         runner.join(30)
         wait_for(lambda: dash.events[-1]["seq"] == own[-1]["seq"], 20, what="the last event after the cut")
-        first = dash.events[0]["seq"]
-        assert [e["seq"] for e in dash.events[1:]] == [e["seq"] for e in own if e["seq"] > first]
-        assert dash.watcher.backfilled == 1  # it joined from the first event
-        assert dash.watcher.gaps_filled + dash.watcher.snapshots >= 1  # it did miss events, and got them back
+        yield dash, own
     finally:
         robot.close()
         proxy.close()
         dash.watcher.close()
+
+
+def every_event_after_the_first(dash: Dashboard, own: list[dict]) -> bool:
+    first = dash.events[0]["seq"]
+    return [e["seq"] for e in dash.events[1:]] == [e["seq"] for e in own if e["seq"] > first]
+
+
+def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quiet):
+    with a_run_cut_for_a_second() as (dash, own):
+        assert every_event_after_the_first(dash, own)
+        assert dash.watcher.backfilled == 1  # it joined from the first event
+        assert dash.watcher.gaps_filled + dash.watcher.snapshots >= 1  # it did miss events, and got them back
 
 
 def test_a_gap_whose_history_the_robot_did_not_answer_in_time_is_filled_later_not_jumped(quiet):
-    endpoint = free_endpoint()
-    dash = Dashboard(listen=[endpoint])
-    proxy = Proxy(endpoint)
-    robot = ZenohRobot("r1", connect=[proxy.endpoint])
-    answered, unanswered = dash.watcher._history, []
+    unanswered = []
 
-    def first_two_unanswered(*query):
-        if len(unanswered) < 2:  # a robot (or a network) too slow for QUERY_TIMEOUT
-            unanswered.append(query)
-            return None
-        return answered(*query)
+    def first_two_unanswered(dash: Dashboard) -> None:
+        answered = dash.watcher._history
 
-    try:
-        sm = slow_loop(300, 0.01)
-        own: list[dict] = []
-        runner = threading.Thread(target=lambda: own.extend(run_on(robot, sm)), daemon=True)
-        runner.start()
-        wait_for(lambda: len(dash.events) > 20, 10, what="events before the cut")
-        dash.watcher._history = first_two_unanswered
-        proxy.cut()
-        time.sleep(1.0)  # the machine runs on, unseen
-        proxy.restore()
-        runner.join(30)
-        wait_for(lambda: dash.events[-1]["seq"] == own[-1]["seq"], 20, what="the last event after the cut")
-        first = dash.events[0]["seq"]
+        def history(*query):
+            if len(unanswered) < 2:  # a robot (or a network) too slow for QUERY_TIMEOUT
+                unanswered.append(query)
+                return None
+            return answered(*query)
+        dash.watcher._history = history
+
+    with a_run_cut_for_a_second(first_two_unanswered) as (dash, own):
         assert len(unanswered) == 2
-        assert [e["seq"] for e in dash.events[1:]] == [e["seq"] for e in own if e["seq"] > first]
-    finally:
-        robot.close()
-        proxy.close()
-        dash.watcher.close()
+        assert every_event_after_the_first(dash, own)
 
 
 def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answers_from_its_status(quiet):

@@ -1,5 +1,6 @@
 """The fsmscope command line, in real processes: run, replay and their exit codes."""
 
+import contextlib
 import json
 import os
 import queue
@@ -24,6 +25,17 @@ def foo_bar_log(tmp_path_factory):
     done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--record", path)
     assert done.returncode == 0, done.stderr
     return path
+
+
+@contextlib.contextmanager
+def killed_if_left(proc: subprocess.Popen):
+    """``proc`` for the test's block, killed if the block leaves it running (a failed check)."""
+    try:
+        yield proc
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
 
 
 def test_run_records_to_the_given_path_and_says_where(foo_bar_log):
@@ -200,7 +212,7 @@ def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(
 
         return wait_for(next_line_matches, 30, interval=0, what="a line matching %r" % pattern)
 
-    try:
+    with killed_if_left(proc):
         base, token = line_matching(r"dashboard at (http://[^/]+)/\?token=(\S+)").groups()
         line_matching("the script ended")
         http = httpx.Client(base_url=base, headers={"Authorization": "Bearer " + token}, timeout=10)
@@ -214,10 +226,6 @@ def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(
         wait_for(the_new_run_ended, 10, interval=0.02, what="the run started from the dashboard to end")
         proc.send_signal(signal.SIGINT)
         assert proc.wait(20) == 0
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
     summary = json.loads(cli("replay", log, "--json").stdout)
     assert summary["machines"]["foo_bar"]["runs"] == 2 and summary["machines"]["foo_bar"]["outcome"] == "end"
 
@@ -249,14 +257,10 @@ def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, si
     log = tmp_path / "sleepy.jsonl"
     proc = subprocess.Popen([sys.executable, "-m", "server.cli", "run", str(script), "--record", str(log)],
                             cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
-    try:
+    with killed_if_left(proc):
         assert "sleeping\n" in proc.stdout  # reads the script's output up to the line (the machine is in SLEEP)
         proc.send_signal(signum)
         assert proc.wait(10) == code  # not still serving the dashboard
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
     last = json.loads(log.read_bytes().splitlines()[-1])
     assert (last["kind"], last["path"]) == ("terminate", "/SM_ROOT")
     assert json.loads(cli("replay", log, "--json").stdout)["problems"] == []
@@ -267,14 +271,10 @@ def test_ctrl_c_stops_a_command_started_with_sigint_ignored(foo_bar_log):
     proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve"], cwd=ROOT,
                             stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
-    try:
+    with killed_if_left(proc):
         assert any("replaying" in line for line in proc.stderr)  # up to the line with its address
         proc.send_signal(signal.SIGINT)
         assert proc.wait(20) == 0
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
 
 
 def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_log):

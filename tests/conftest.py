@@ -156,7 +156,7 @@ def headless_demo_log(tmp_path_factory):
     path = shared / "headless-demo.jsonl"
     with open(shared / "headless-demo.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        recorded = shared / "headless-demo.recorded"  # a worker that failed recording leaves no log behind it
+        recorded = shared / "headless-demo.recorded"  # touched once the log is whole: a failed one is recorded again
         if not recorded.exists():
             path.unlink(missing_ok=True)
             done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",

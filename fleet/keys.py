@@ -48,14 +48,23 @@ def control_key(robot: str, machine: str) -> str:
     return machine_key(robot, machine) + "/control"
 
 
-def dashboard_key(session_id: str) -> str:
-    """A dashboard's liveliness token: a robot whose machine it holds a lease on applies the deadman
-    when it is gone (fleet/control.py). Outside ``fsmscope/``: no dashboard is taken for a machine."""
-    return "%s-dashboards/%s" % (PREFIX, chunk(session_id, "dashboard"))
+def beat_key(session_id: str, robot: str) -> str:
+    """Where a dashboard puts its heartbeats for ``robot`` while it leases one of its machines
+    (fleet/beats.py). Outside ``fsmscope/``: no dashboard is taken for a machine."""
+    return "%s-dashboards/%s/%s" % (PREFIX, chunk(session_id, "dashboard"), chunk(robot, "robot"))
+
+
+def beats_for(robot: str) -> str:
+    """Every dashboard's heartbeats for ``robot``."""
+    return "%s-dashboards/*/%s" % (PREFIX, chunk(robot, "robot"))
+
+
+def beat_sender(key: str) -> str:
+    """The dashboard's session id of a heartbeat's key."""
+    return key.split("/")[1]
 
 
 ALL_MACHINES = PREFIX + "/*/*"
-ALL_DASHBOARDS = PREFIX + "-dashboards/*"
 ALL_EVENTS = PREFIX + "/*/*/events"
 
 

@@ -25,8 +25,12 @@ Per machine it also declares, on the machine's first event:
 - a queryable ``.../history?since=SEQ``: the events from SEQ on, of the newest ``RING`` (the batches
   put that hold them, then those waiting for the tick): a dashboard whose connection dropped fills
   its gap, one that joins takes the machine from its first event (older than that: the snapshot);
-- a queryable ``.../control``: a dashboard's control, carrying the robot's token, applied to the
+- a queryable ``.../control``: a dashboard's control, proving the robot's token, applied to the
   machine and answered (fleet/control.py).
+
+Every batch and every answer carries its proof of the robot's token (fleet/proofs.py): a dashboard
+shows only what proves it, so nobody without the token can pose as the robot. A robot given no
+token makes one and says it on stderr: a dashboard needs it to show the robot's machines.
 
 When nobody listens or the network is gone, puts go nowhere and the machine runs on; memory stays
 bounded by the batches and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
@@ -35,6 +39,8 @@ bounded by the batches and the rings. Imports only the standard library, ``zenoh
 from __future__ import annotations
 
 import collections
+import secrets
+import sys
 import threading
 import time
 from time import monotonic
@@ -47,9 +53,10 @@ from fsm.observation import closing, introspection, schema
 from fsm.observation.encoding import dumps, encoded
 from fsm.observation.status import Status
 
-from . import keys
+from . import keys, proofs
 from .config import open_session
 from .control import RobotControls
+from .query import reply
 
 RING = 10_000  # events of each machine kept (as the batches put) for history queries
 MAX_BATCH = 512  # events per put at most (a payload of about 100 kB: larger ones cost more per byte to
@@ -78,8 +85,8 @@ class _Machine:
         self.closed = False
         self.controls = controls
         self.origin = str(session.zid())  # a new process is a new session: its seqs start again
-        self.publisher = session.declare_publisher(keys.events_key(robot, name),
-                                                   congestion_control=zenoh.CongestionControl.DROP)
+        self.key = keys.events_key(robot, name)
+        self.publisher = session.declare_publisher(self.key, congestion_control=zenoh.CongestionControl.DROP)
         self.state = session.declare_queryable(keys.state_key(robot, name), self._state)
         self.history = session.declare_queryable(keys.history_key(robot, name), self._history)
         self.control = controls.declare(session, keys.control_key(robot, name), name)
@@ -120,7 +127,7 @@ class _Machine:
                 return self.due
             items = [pending.popleft() for _ in range(len(pending))]
             payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
-            self.publisher.put(payload)
+            self.publisher.put(payload, attachment=batch_attachment(self.controls.token, self.key, self.origin, payload))
             ring = self.ring
             ring.append((items[0][0], items[-1][0], len(items), payload))
             self.kept += len(items)
@@ -134,8 +141,8 @@ class _Machine:
             status = current()
             snapshot = schema.build.snapshot(status.last_seq, time.time(), status.run, self.name,
                                              status.root_path or "/SM_ROOT", dict(status.to_dict(), machine=self.name))
-        query.reply(query.key_expr, dumps({"snapshot": snapshot, "controls": self.controls.offer(self.name),
-                                           "origin": self.origin}))
+        reply(query, self.controls.token, dumps({"snapshot": snapshot, "controls": self.controls.offer(self.name),
+                                                 "origin": self.origin}))
 
     def _history(self, query: zenoh.Query) -> None:
         try:
@@ -151,8 +158,8 @@ class _Machine:
         # The batches holding the events from ``since`` on (the dashboard drops those before it had),
         # and the events waiting for the next tick.
         complete = first is not None and first <= since
-        query.reply(query.key_expr, b'{"complete":%s,"events":[%s]}' % (b"true" if complete else b"false",
-                                                                       b",".join(parts)))
+        reply(query, self.controls.token, b'{"complete":%s,"events":[%s]}' % (b"true" if complete else b"false",
+                                                                             b",".join(parts)))
 
     def close(self) -> None:
         with self.putting:
@@ -161,21 +168,31 @@ class _Machine:
             entity.undeclare()
 
 
+def batch_attachment(token: str, key: str, origin: str, payload: bytes) -> bytes:
+    """A batch's attachment: its proof of the robot's token, then the robot's process (session id)."""
+    return proofs.sign(token, b"events", key, origin.encode(), payload) + origin.encode()
+
+
 class ZenohRobot:
     """An observer (``fsm.attach(sm, ZenohRobot("r1", ...))``) that puts a robot's machines on Zenoh.
     ``connect`` / ``listen``: Zenoh endpoints (``tcp/HOST:PORT``); ``mode``: "peer" or "client";
     ``scouting``: multicast discovery on the LAN (off unless asked); ``config_file``: a Zenoh
-    configuration file under those (fleet/config.py). ``token``: what a dashboard's control must
-    carry (none: the robot takes no control); ``can_start``: whether a start may run a machine again
+    configuration file under those (fleet/config.py). ``token``: what the robot's batches and
+    answers prove, and a dashboard's controls must prove (none: one is made, and said on stderr);
+    ``controls``: False refuses every control; ``can_start``: whether a start may run a machine again
     (in a new thread)."""
 
     def __init__(self, robot: str, connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
                  scouting: bool = False, token: str | None = None, can_start: bool = False,
-                 config_file: str | None = None) -> None:
+                 config_file: str | None = None, controls: bool = True) -> None:
         self.robot = keys.robot_chunk(robot)
         self.can_start = can_start
         self.session = open_session(connect, listen, mode, scouting, config_file)
-        self.controls = RobotControls(token, self.flush)
+        if not token:
+            token = secrets.token_urlsafe(24)
+            print("fsmscope: robot %r proves its machines with the token %s (a dashboard shows and controls "
+                  "them with serve --zenoh-token %s=%s)" % (robot, token, robot, token), file=sys.stderr, flush=True)
+        self.controls = RobotControls(self.robot, token, controls, self.flush)
         self._stop = threading.Event()
         self._wake = threading.Event()  # a batch began: the flusher puts it if its machine goes quiet
         self._machines: dict[str, _Machine] = {}

@@ -21,40 +21,53 @@ what they read one at a time, under one lock. The events' reader delivers, and a
 follows for a gap; no other hop is taken per batch (each costs a fleet's dashboard more than the
 batch's events do). A reader handles what its channel holds before it says ``settled``: the robots
 put on the same tick, and the dashboard's loop is woken once for them. A third thread joins the
-machines, asking their state and history without the lock: a machine that answers slowly, or a
-stranger's token that nobody answers for, never holds up the events of the others. Events of a
+machines: it sends the state queries of up to ``MAX_JOINS`` machines at once without waiting for
+them (their answers come back to it), and asks a machine's history once its state answered, without
+the lock: a machine that answers slowly, or a stranger's token that nobody answers for, never holds
+up the events or the joins of the others. Events of a
 machine whose token was never seen are skipped (anyone on the network can put on these keys: asking
 for each would let one put a second stop the dashboard for five); those of a machine alive but not
 joined yet ask its join again, at most once per ``JOIN_AGAIN``, and are asked for from its history
 once it is joined (they may be its run's last: nothing would follow them to show the gap). A new
 process's events wait for its join too: its seqs count from 1 again.
 
+Only what proves the robot's token is taken (fleet/proofs.py): a batch whose proof is not that of
+the token this dashboard holds for its robot (``tokens``: by robot, None for any robot's) is refused
+and counted in ``refusals``, and so is every answer to a query; a robot for which the dashboard has
+no token is not shown, and that is said. A batch's proof covers the robot's process, so a new
+process's batches ask its join, and a batch's seqs must follow each other: not even a robot's
+batch moves the dashboard's idea of its sequence by more than the events it holds.
+
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
-sends a control to the machine's robot (fleet/control.py). The watcher's liveliness token
-(``fsmscope-dashboards/<session>``) tells robots whose machines it leases that it is there.
+sends a control to the machine's robot (fleet/control.py). While it leases a robot's machine, the
+watcher beats for it (fleet/beats.py).
 """
 
 from __future__ import annotations
 
+import collections
+import itertools
 import queue
 import sys
 import threading
 from time import monotonic
-from typing import Any, Callable, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
 import zenoh
 
 from fsm.observation import closing
 from fsm.observation.encoding import loads
 
-from . import control, keys
+from . import control, keys, proofs
+from .beats import Heartbeats
 from .config import open_session
-from .query import first_reply
+from .query import first_reply, send
 
 QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
 QUEUE = 10_000  # samples waiting in a channel for the watcher's thread before the oldest are dropped
 BURST = 64  # samples handled at most before ``settled`` is called, when they keep coming
 JOIN_AGAIN = 1.0  # seconds before the events of a machine alive but not joined ask its join again
+MAX_JOINS = 256  # machines whose state query is on its way at once; more wait for their turn
 
 
 def fleet_name(robot: str, machine: str) -> str:
@@ -71,8 +84,9 @@ class FleetWatcher:
     def __init__(self, deliver: Callable[[list[dict]], None], alive: Callable[[str, bool], None],
                  connect: Sequence[str] = (), listen: Sequence[str] = (), mode: str = "peer",
                  scouting: bool = False, config_file: str | None = None,
-                 settled: Callable[[], None] = lambda: None) -> None:
+                 settled: Callable[[], None] = lambda: None, tokens: Mapping[str | None, str] = {}) -> None:
         self.deliver = deliver
+        self.tokens = dict(tokens)
         self.alive = alive
         self.settled = settled
         self.session = open_session(connect, listen, mode, scouting, config_file)
@@ -83,14 +97,21 @@ class FleetWatcher:
         self._alive: set[str] = set()  # machines whose liveliness token is up
         self._asked: dict[str, float] = {}  # machine -> when its join was last asked for
         self._skipped: set[str] = set()  # machines whose events came while their join was on its way
-        self._joins: queue.SimpleQueue[str | None] = queue.SimpleQueue()  # machine keys to join; None: stop
+        # Machine keys to join, and state answers (key, answer) for the joins' thread; None: stop.
+        self._joins: queue.SimpleQueue[str | tuple[str, bytes | None] | None] = queue.SimpleQueue()
+        self._joining: set[str] = set()  # keys whose state query is on its way (the joins' thread's)
+        self._waiting: collections.deque[str] = collections.deque()  # keys past MAX_JOINS, in turn
+        self._counter = itertools.count(1)  # of this dashboard's controls: a robot takes each once
+        self._cancel = zenoh.CancellationToken()  # the joins' state queries on their way, at close
         self.gaps_filled = 0
         self.snapshots = 0
         self.backfilled = 0  # machines taken from their first event
-        self.rejected = 0  # samples (and answers) that were not what a robot puts or answers
+        self.rejections = proofs.Tally("fsmscope")  # proven samples and answers that were not what a robot sends
+        self.refusals = proofs.Tally("fsmscope")  # batches that do not prove their robot's token
+        self._untrusted: set[str] = set()  # robots this dashboard has no token for (said once each)
         self.unannounced = 0  # event samples skipped: their machine's token was never seen
         self.id = str(self.session.zid())
-        self._presence = self.session.liveliness().declare_token(keys.dashboard_key(self.id))
+        self.beats = Heartbeats(self.session, self.id)
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
         # process from ending); the events' channel drops the oldest when full (the gap is filled after).
         self._events = self.session.declare_subscriber(keys.ALL_EVENTS, zenoh.handlers.RingChannel(QUEUE))
@@ -108,7 +129,8 @@ class FleetWatcher:
             return
         self._closed = True
         self._joins.put(None)
-        self._presence.undeclare()
+        self._cancel.cancel()
+        self.beats.close()
         self._tokens.undeclare()
         self._events.undeclare()
         self.session.close()
@@ -138,14 +160,44 @@ class FleetWatcher:
         except zenoh.ZError:  # the session closed
             pass
 
+    @property
+    def rejected(self) -> int:
+        """Samples and answers that proved their robot's token but were not what a robot sends."""
+        return self.rejections.count
+
     def _join_all(self) -> None:
-        """The joins' thread: each machine key asked for, joined (its queries wait without the lock)."""
+        """The joins' thread: each machine key asked for gets its state query sent (``MAX_JOINS`` on
+        their way at most); each state answer is joined (its history asked, waiting without the lock)."""
         try:
-            while (key := self._joins.get()) is not None:
-                self._handle(self._join, key)
-                self.settled()
+            while (item := self._joins.get()) is not None:
+                if type(item) is str:
+                    self._send_join(item)
+                    continue
+                key, answer = item
+                self._joining.discard(key)
+                while self._waiting and len(self._joining) < MAX_JOINS:
+                    self._send_join(self._waiting.popleft())
+                if answer is not None:
+                    self._handle(self._join, (key, answer))
+                    self.settled()
         except zenoh.ZError:  # the session closed
             pass
+
+    def _send_join(self, key: str) -> None:
+        """In the joins' thread: the machine's state query, unless one is on its way (or waits)."""
+        if key in self._joining or key in self._waiting:
+            return
+        if len(self._joining) >= MAX_JOINS:
+            self._waiting.append(key)
+            return
+        self._joining.add(key)
+        robot, machine = keys.split(key)
+        send(self.session, keys.state_key(robot, machine), self._token(robot), QUERY_TIMEOUT,
+             lambda answer: self._joins.put((key, answer)), cancel=self._cancel)
+
+    def _token(self, robot: str) -> str | None:
+        """The token this dashboard holds for ``robot``'s proofs."""
+        return self.tokens.get(robot, self.tokens.get(None))
 
     def _handle(self, handle: Callable[[Any], None], item: Any) -> None:
         """One sample (or a machine to join); what is not what a robot puts or answers (anyone on the
@@ -155,11 +207,9 @@ class FleetWatcher:
         except zenoh.ZError:
             raise
         except Exception as exc:
-            self.rejected += 1
-            if self.rejected & (self.rejected - 1) == 0:  # the 1st, 2nd, 4th, 8th...: a flood says little
-                print("fsmscope: what came on %s is not a robot's (%s: %s); %d so far" % (
-                    getattr(item, "key_expr", item), type(exc).__name__, str(exc)[:200], self.rejected),
-                    file=sys.stderr, flush=True)
+            where = item[0] if type(item) is tuple else getattr(item, "key_expr", item)
+            self.rejections.refused("what came on %s, which is not a robot's (%s: %s)" % (
+                where, type(exc).__name__, str(exc)[:200]))
 
     def _ask_join(self, name: str, key: str) -> None:
         """Under the lock: have the joins' thread join the machine."""
@@ -180,10 +230,17 @@ class FleetWatcher:
                 self._alive.discard(name)
 
     def _on_events(self, sample: zenoh.Sample) -> None:
-        robot, machine = keys.split(str(sample.key_expr))
+        key = str(sample.key_expr)
+        robot, machine = keys.split(key)
         name = fleet_name(robot, machine)
+        payload = sample.payload.to_bytes()
+        attachment = sample.attachment.to_bytes() if sample.attachment is not None else b""
+        proof, origin = attachment[:proofs.SIZE], attachment[proofs.SIZE:]
+        if not self._proven(robot, key, proof, origin, payload):
+            return
         with self._lock:
-            if name not in self._last:  # not joined (yet: its token came, its join is on its way)
+            if name not in self._last or origin.decode() != self._origins.get(name):
+                # Not joined (yet: its token came, its join is on its way), or a new process of its robot.
                 if name not in self._alive:
                     self.unannounced += 1
                     return
@@ -191,8 +248,8 @@ class FleetWatcher:
                 if monotonic() - self._asked.get(name, 0.0) >= JOIN_AGAIN:  # its state did not answer
                     self._ask_join(name, keys.machine_key(robot, machine))
                 return
-            events = loads(sample.payload.to_bytes())
-            if events and events[0]["seq"] > self._last[name] + 1:
+            events = consecutive(loads(payload))
+            if events[0]["seq"] > self._last[name] + 1:
                 self._fill(robot, machine, self._last[name] + 1)
                 if events[0]["seq"] > self._last[name] + 1:  # the robot did not answer in time: never past a gap
                     self._skipped.add(name)
@@ -200,6 +257,21 @@ class FleetWatcher:
                         self._ask_join(name, keys.machine_key(robot, machine))
                     return
             self._deliver(name, events)
+
+    def _proven(self, robot: str, key: str, proof: bytes, origin: bytes, payload: bytes) -> bool:
+        """Whether a batch proves its robot's token; refused, counted and said when not."""
+        token = self._token(robot)
+        if token is None:
+            if robot not in self._untrusted:
+                self._untrusted.add(robot)
+                print("fsmscope: the machines of robot %r are not shown: this dashboard has no token for it "
+                      "(serve --zenoh-token %s=TOKEN)" % (robot, robot), file=sys.stderr, flush=True)
+            self.refusals.count += 1
+            return False
+        if proofs.proven(token, proof, b"events", key, origin, payload):
+            return True
+        self.refusals.refused("a batch on %s that does not prove the token of robot %r" % (key, robot))
+        return False
 
     def _deliver(self, name: str, events: list[dict]) -> None:
         last = self._last.get(name, 0)
@@ -213,22 +285,28 @@ class FleetWatcher:
 
     def _state(self, robot: str, machine: str) -> dict | None:
         """The machine's state answer (its snapshot, controls and origin); None when none came."""
-        answer = first_reply(self.session, keys.state_key(robot, machine), QUERY_TIMEOUT)
+        answer = first_reply(self.session, keys.state_key(robot, machine), self._token(robot), QUERY_TIMEOUT)
         return None if answer is None else loads(answer)
 
     def _history(self, robot: str, machine: str, since: int) -> dict | None:
         """The robot's answer of the machine's events from ``since`` on; None when none came."""
-        reply = first_reply(self.session, keys.history_key(robot, machine) + "?since=%d" % since, QUERY_TIMEOUT)
-        return None if reply is None else loads(reply)
+        reply = first_reply(self.session, keys.history_key(robot, machine), self._token(robot), QUERY_TIMEOUT,
+                            "since=%d" % since)
+        if reply is None:
+            return None
+        history = loads(reply)
+        if history["events"]:
+            consecutive(history["events"])
+        return history
 
-    def _join(self, key: str) -> None:
-        """In the joins' thread, the queries without the lock: a machine seen alive, new, or back after a
-        drop (what it missed), or from a new process (taken again)."""
+    def _join(self, item: tuple[str, bytes]) -> None:
+        """In the joins' thread, with a machine's state answer; its history asked without the lock: a
+        machine seen alive, new, or back after a drop (what it missed), or from a new process (taken
+        again)."""
+        key, said = item
         robot, machine = keys.split(key)
         name = fleet_name(robot, machine)
-        answer = self._state(robot, machine)
-        if answer is None:
-            return  # its next events ask again
+        answer = loads(said)
         with self._lock:
             back = name in self._last and answer["origin"] == self._origins.get(name)
             since = self._last[name] + 1 if back else 1
@@ -282,6 +360,19 @@ class FleetWatcher:
                      lambda: self._state(robot, machine))
 
     def ask(self, robot: str, machine: str, token: str, action: str, params: dict, client: str) -> dict | None:
-        """A control for ``robot``'s ``machine``: its robot's answer, None when none came in time."""
-        return control.ask(self.session, keys.control_key(robot, machine), token, action, params, client,
-                           QUERY_TIMEOUT)
+        """A control for ``robot``'s ``machine``, proven with ``token``: its robot's proven answer,
+        None when none came in time. A lease the robot took has this watcher beat for it."""
+        fields = {"action": action, "params": params, "client": client, "dashboard": self.id,
+                  "counter": next(self._counter), "origin": self._origins.get(fleet_name(robot, machine), "")}
+        answer = control.ask(self.session, keys.control_key(robot, machine), token, fields, QUERY_TIMEOUT)
+        if action == "lease" and answer is not None and answer.get("status") == 200:
+            self.beats.keep(robot, token)
+        return answer
+
+
+def consecutive(events: list[dict]) -> list[dict]:
+    """A robot's batch, whose seqs follow each other; ValueError when they do not."""
+    first = events[0]["seq"]
+    if type(first) is not int or any(event["seq"] != first + i for i, event in enumerate(events)):
+        raise ValueError("a batch's seqs do not follow each other")
+    return events

@@ -18,12 +18,17 @@ from pathlib import Path
 import fsm
 import httpx
 
+from fleet.watcher import FleetWatcher
 from fsm.logfiles.log_reader import read_events
+from fsm.observation.status import Status
 from server.testing.demo_process import free_endpoint
 from server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
 PATROL = Path(__file__).resolve().parent / "robots" / "patrol.py"
+
+TOKEN = "the-fleets-token"  # what the tests' robots prove, and their dashboards hold
+
 
 
 class Tick(fsm.State):
@@ -250,3 +255,23 @@ def preempted_the_dashboard_has_the_robots_log(dash: Dashboard, robot: Robot, si
     seen = history(dash, "r1:patrol", since)
     shown, logged = [(e["seq"], e["kind"]) for e in seen], [(e["seq"], e["kind"]) for e in own]
     assert shown == logged, "missing %r, extra %r" % (sorted(set(logged) - set(shown)), sorted(set(shown) - set(logged)))
+
+
+class Delivered:
+    """What a watcher delivered: the events, in order, and each machine's comings and goings."""
+
+    def __init__(self, **session) -> None:
+        self.events: list[dict] = []
+        self.alive: list[tuple[str, bool]] = []
+        self.watcher = FleetWatcher(self.events.extend, lambda name, up: self.alive.append((name, up)),
+                                   tokens={None: TOKEN}, **session)
+
+    def status(self, name: str) -> Status:
+        """The machine's state rebuilt from what was delivered: from its last snapshot (or its first
+        event), the events."""
+        events = [event for event in self.events if event["machine"] == name]
+        start = max([i for i, event in enumerate(events) if event["kind"] == "snapshot"], default=0)
+        status = Status(name)
+        for event in events[start:]:
+            status.apply(event)
+        return status

@@ -4,7 +4,8 @@ follows every robot's machines on Zenoh; what it delivers goes through the hub's
 event checked against the schema, as a publisher's are) on the server's event loop, and a machine
 whose liveliness token is withdrawn is shown disconnected (``connected: false``) until it is back.
 A machine whose robot takes controls gets a ``RemoteHandle`` (server/remote_control.py) whose link
-is a ``FleetLink``: each control is a Zenoh query carrying the robot's token (fleet/control.py)."""
+is a ``FleetLink``: each control is a Zenoh query proving the robot's token (fleet/control.py), and
+only batches and answers that prove it are shown (fleet/proofs.py)."""
 
 from __future__ import annotations
 
@@ -54,16 +55,17 @@ class FleetLink:
             raise not_connected(machine)
         answer = self.watcher.ask(self.robot, self.machine, self.token, action, params, client)
         if answer is None:
-            # Zenoh ends a query its access control denies as if nobody were there: say both.
-            raise Refused(504, "robot %r did not answer the control of %r: it is unreachable, or its Zenoh "
-                                    "access control denies this dashboard's controls" % (self.robot, self.machine))
+            # Zenoh ends a query its access control denies as if nobody were there, and a robot
+            # answers no control that does not prove its token: say each.
+            raise Refused(504, "no authenticated answer from robot %r to the control of %r: it is unreachable, "
+                               "its Zenoh access control denies this dashboard's controls, or this dashboard's "
+                               "token for it is not the robot's" % (self.robot, self.machine))
         return taken(machine, answer)
 
     def post(self, frame: dict) -> None:
         """A lease frame (any thread, never waits): the robot is told, naming this dashboard's session,
-        so that it applies the deadman itself when this dashboard is gone (fleet/control.py)."""
+        so that it applies the deadman itself when this dashboard's beats stop (fleet/control.py)."""
         params = {key: frame[key] for key in ("held", "after", "action")}
-        params["dashboard"] = self.watcher.id
         threading.Thread(target=self._tell, args=(params,), name="fsmscope-fleet-lease", daemon=True).start()
 
     def _tell(self, params: dict) -> None:
@@ -152,7 +154,8 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
     try:
         watcher = FleetWatcher(lambda events: inbox.post(ingest, events), lambda name, up: inbox.post(seen, name, up),
                                connect=args.zenoh, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                               scouting=args.zenoh_scouting, config_file=args.zenoh_config, settled=inbox.wake)
+                               scouting=args.zenoh_scouting, config_file=args.zenoh_config, settled=inbox.wake,
+                               tokens=tokens)
     except ValueError as exc:
         raise CannotServe(str(exc)) from None
     print("fsmscope: following the fleet on Zenoh (%s)" % reach(args.zenoh, args), file=sys.stderr, flush=True)

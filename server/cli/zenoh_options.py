@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import secrets
 import sys
 from typing import TYPE_CHECKING
 
@@ -34,10 +33,11 @@ def add_zenoh_arguments(parser: argparse.ArgumentParser, publish: bool) -> None:
     parser.add_argument("--zenoh-listen", action="append", default=[], metavar="ENDPOINT",
                         help="with --zenoh: also listen on this endpoint, for sessions that connect here")
     parser.add_argument("--zenoh-token", action="append", default=[], metavar="[ROBOT=]TOKEN",
-                        help=("with --zenoh: the token the robot's controls must carry (default: $%s; none: a new "
-                              "one, printed)" % TOKEN_ENV) if publish else
-                             ("with --zenoh: the token to control the robots' machines with; ROBOT=TOKEN for one "
-                              "robot's (default: $%s; none: the fleet is watched, not controlled)" % TOKEN_ENV))
+                        help=("with --zenoh: the token the robot's batches and answers prove, and dashboards' "
+                              "controls must prove (default: $%s; none: a new one, printed)" % TOKEN_ENV) if publish else
+                             ("with --zenoh: the token of the robots whose machines are shown and controlled; "
+                              "ROBOT=TOKEN for one robot's (default: $%s; a robot without one is not shown)"
+                              % TOKEN_ENV))
     parser.add_argument("--zenoh-mode", choices=("peer", "client"), default="peer",
                         help="with --zenoh: peer (default; a robot connecting to a router stays one), or client of "
                              "a router (a dashboard behind one)")
@@ -81,17 +81,12 @@ def zenoh_robot(args: argparse.Namespace, can_start: bool) -> ZenohRobot | None:
         return None
     from fleet.robot import ZenohRobot
 
-    given = zenoh_tokens(args).get(None)
-    token = given or secrets.token_urlsafe(24)
-    try:
+    try:  # given no token, the robot makes one and says it
         robot = ZenohRobot(args.zenoh, connect=args.zenoh_connect, listen=args.zenoh_listen, mode=args.zenoh_mode,
-                           scouting=args.zenoh_scouting, token=token, can_start=can_start,
+                           scouting=args.zenoh_scouting, token=zenoh_tokens(args).get(None), can_start=can_start,
                            config_file=args.zenoh_config)
     except ValueError as exc:  # a name Zenoh cannot take, an endpoint it cannot use
         raise CannotServe(str(exc)) from None
-    if given is None:
-        print("fsmscope: the token of robot %r's controls: %s (serve --zenoh-token %s=%s)"
-              % (args.zenoh, token, args.zenoh, token), file=sys.stderr, flush=True)
     print("fsmscope: publishing on Zenoh as robot %r (%s)" % (args.zenoh, reach(args.zenoh_connect, args)),
           file=sys.stderr, flush=True)
     return robot

@@ -28,14 +28,13 @@ from types import SimpleNamespace
 
 import fsm
 import pytest
-from fleet_support import Dashboard, free_endpoint, run_published, slow_loop
+from fleet_support import TOKEN, Dashboard, free_endpoint, run_published, slow_loop
 
 from fleet import control, keys
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from server.testing.polling import wait_for
 
-TOKEN = "the-robots-token"
 PASSWORDS = {"operator": "operator-secret", "viewer": "viewer-secret"}
 EVERY_MESSAGE = ["put", "delete", "declare_subscriber", "query", "declare_queryable", "reply", "liveliness_token",
                  "declare_liveliness_subscriber", "liveliness_query"]  # zenoh-config's AclMessage, all of them
@@ -99,7 +98,7 @@ def fleet(tmp_path):
         seen: list[dict] = []
         alive: list[tuple[str, bool]] = []
         watcher = FleetWatcher(seen.extend, lambda name, up: alive.append((name, up)), connect=[endpoint],
-                               config_file=dashboard_configuration(tmp_path, user, password))
+                               config_file=dashboard_configuration(tmp_path, user, password), tokens={None: TOKEN})
         watchers.append(watcher)
         return SimpleNamespace(watcher=watcher, seen=seen, alive=alive)
 
@@ -169,8 +168,10 @@ def test_zenoh_ends_a_viewers_query_on_the_control_key_at_once_without_a_reply(f
     joined(viewer)
     session = viewer.watcher.session
     started = time.monotonic()
-    replies = list(session.get(keys.control_key("r1", "loop"), payload=control.request(TOKEN, "preempt", {}, "viewer"),
-                               timeout=5.0))
+    key = keys.control_key("r1", "loop")
+    payload, proof = control.request(TOKEN, key, {"action": "preempt", "params": {}, "client": "viewer", "counter": 1,
+                                                  "dashboard": viewer.watcher.id, "origin": fleet.robot.controls.origin})
+    replies = list(session.get(key, payload=payload, attachment=proof, timeout=5.0))
     assert replies == []  # neither the robot's answer nor an error reply
     assert time.monotonic() - started < 2.5  # not the query's 5 s time-out
     [state] = list(session.get(keys.state_key("r1", "loop"), timeout=5.0))  # a query it may ask is answered

@@ -7,13 +7,12 @@ from __future__ import annotations
 
 import fsm
 import pytest
-from fleet_support import free_endpoint, run_published, slow_loop
+from fleet_support import TOKEN, free_endpoint, run_published, slow_loop
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from server.testing.polling import wait_for
 
-TOKEN = "the-robots-token"
 
 
 @pytest.fixture
@@ -22,7 +21,7 @@ def fleet():
     until preempted; yields (watcher, robot, the events of the robot's own stream)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     endpoint = free_endpoint()
-    watcher = FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint])
+    watcher = FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint], tokens={None: TOKEN})
     robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
     sm = slow_loop(100_000, 0.02)
     own, runner = run_published(robot, sm)
@@ -49,10 +48,9 @@ def test_a_control_with_the_robots_token_is_applied_recorded_and_answered_with_i
         "preempt", "accepted", "operator", "from the fleet page")
 
 
-def test_a_control_with_a_wrong_token_is_refused_by_the_robot(fleet):
+def test_a_control_with_a_wrong_token_is_refused_by_the_robot_with_no_authenticated_answer(fleet):
     watcher, robot, own = fleet
-    answer = watcher.ask("r1", "loop", "not-" + TOKEN, "preempt", {}, "intruder")
-    assert answer == {"status": 403, "detail": "wrong token for this robot's controls"}
+    assert watcher.ask("r1", "loop", "not-" + TOKEN, "preempt", {}, "intruder") is None
     assert robot.controls.refused == 1
     assert controls_of(own) == []
 
@@ -64,19 +62,25 @@ def test_a_control_the_machine_refuses_is_answered_with_why(fleet):
     assert [(e["action"], e["result"]) for e in controls_of(own)] == [("start", "this process cannot re-run the machine")]
 
 
-def test_a_robot_started_without_a_token_takes_no_control():
+def test_a_robot_started_without_controls_takes_none():
     fsm.set_loggers(*(lambda msg: None,) * 4)
     endpoint = free_endpoint()
-    with FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint]) as watcher, \
-            ZenohRobot("r1", connect=[endpoint]) as robot:
+    with FleetWatcher(lambda events: None, lambda name, up: None, listen=[endpoint], tokens={None: TOKEN}) as watcher, \
+            ZenohRobot("r1", connect=[endpoint], token=TOKEN, controls=False) as robot:
         sm = slow_loop(3, 0.0)
         fsm.attach(sm, robot, name="loop")
         sm.execute()
         robot.flush()
         wait_for(lambda: "r1:loop" in watcher.controls, 10, what="the machine joined")
         assert watcher.controls["r1:loop"] is None  # the dashboard is told: it shows no control
-        answer = watcher.ask("r1", "loop", "", "preempt", {}, "operator")
-        assert answer["status"] == 403 and "without a control token" in answer["detail"]
+        answer = watcher.ask("r1", "loop", TOKEN, "preempt", {}, "operator")
+        assert answer["status"] == 403 and "without controls" in answer["detail"]
+
+
+def test_a_robot_given_no_token_makes_one_and_says_it(capfd):
+    with ZenohRobot("r1", connect=[free_endpoint()]) as robot:
+        said = capfd.readouterr().err
+    assert len(robot.controls.token) >= 32 and "serve --zenoh-token r1=%s" % robot.controls.token in said
 
 
 def test_the_robot_applies_the_deadman_when_the_dashboard_holding_the_lease_is_gone(fleet):

@@ -11,7 +11,7 @@ from __future__ import annotations
 import fsm
 import pytest
 import zenoh
-from fleet_support import (Dashboard, Robot, Router, free_endpoint, preempted_the_dashboard_has_the_robots_log,
+from fleet_support import (TOKEN, Dashboard, Robot, Router, free_endpoint, preempted_the_dashboard_has_the_robots_log,
                            run_published, slow_loop)
 
 from fleet.config import session_config
@@ -19,7 +19,6 @@ from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from server.testing.polling import wait_for
 
-TOKEN = "the-robots-token"
 
 
 @pytest.fixture
@@ -32,7 +31,7 @@ def behind_a_router():
     delivered: list[dict] = []
     seen: list[tuple[str, bool]] = []
     watcher = FleetWatcher(delivered.extend, lambda name, up: seen.append((name, up)), connect=[endpoint],
-                           mode="client")
+                           mode="client", tokens={None: TOKEN})
     robot = ZenohRobot("r1", connect=[endpoint], mode="client", token=TOKEN)
     try:
         yield watcher, robot, delivered, seen

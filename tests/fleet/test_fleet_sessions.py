@@ -9,7 +9,7 @@ import subprocess
 import sys
 
 import pytest
-from fleet_support import ROOT, free_endpoint, started, stop
+from fleet_support import TOKEN, ROOT, free_endpoint, started, stop
 
 from fleet.robot import ZenohRobot
 
@@ -36,14 +36,14 @@ def listening_ports() -> set[int]:
 
 def test_a_robot_that_connects_to_a_dashboard_listens_on_no_port():
     before = listening_ports()
-    with ZenohRobot("r1", connect=[free_endpoint()]):
+    with ZenohRobot("r1", connect=[free_endpoint()], token=TOKEN):
         assert listening_ports() - before == set()
 
 
 def test_a_robot_told_to_listen_listens_there_only():
     endpoint = free_endpoint()
     before = listening_ports()
-    with ZenohRobot("r1", listen=[endpoint]):
+    with ZenohRobot("r1", listen=[endpoint], token=TOKEN):
         assert listening_ports() - before == {int(endpoint.rsplit(":", 1)[1])}
 
 
@@ -63,7 +63,7 @@ def test_an_endpoint_zenoh_cannot_use_ends_the_command_with_why(command):
 
 def test_a_router_whose_port_is_taken_says_so():
     endpoint = free_endpoint()
-    with ZenohRobot("r1", listen=[endpoint]):
+    with ZenohRobot("r1", listen=[endpoint], token=TOKEN):
         done = subprocess.run([sys.executable, "-m", "server.cli", "router", "--listen", endpoint], cwd=ROOT,
                               capture_output=True, text=True, timeout=60)
     assert done.returncode == 1

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import fsm
 import pytest
-from fleet_support import ROOT, free_endpoint, slow_loop
+from fleet_support import TOKEN, ROOT, free_endpoint, slow_loop
 
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
@@ -73,7 +73,7 @@ def listening(certificates, mutual: bool):
     if mutual:
         tls.update(enable_mtls=True, root_ca_certificate=str(certificates["ca"]))
     watcher = FleetWatcher(delivered.extend, lambda name, up: None, listen=[endpoint],
-                           config_file=config_file(certificates, "dashboard", tls))
+                           config_file=config_file(certificates, "dashboard", tls), tokens={None: TOKEN})
     try:
         yield endpoint, delivered
     finally:
@@ -103,7 +103,7 @@ def run_published(robot: ZenohRobot) -> list[dict]:
 def test_a_robot_that_trusts_the_dashboards_authority_reaches_it_over_tls(certificates, dashboard):
     endpoint, delivered = dashboard
     trusting = config_file(certificates, "robot", {"root_ca_certificate": str(certificates["ca"])})
-    robot = ZenohRobot("r1", connect=[endpoint], config_file=trusting)
+    robot = ZenohRobot("r1", connect=[endpoint], config_file=trusting, token=TOKEN)
     try:
         own = run_published(robot)
         wait_for(lambda: delivered and delivered[-1]["seq"] == own[-1]["seq"], 10, what="the last event over TLS")
@@ -124,7 +124,7 @@ def assert_never_delivered(robot: ZenohRobot, delivered: list[dict]) -> None:
 def test_a_robot_that_trusts_another_authority_never_reaches_the_dashboard(certificates, dashboard):
     endpoint, delivered = dashboard
     distrusting = config_file(certificates, "stranger", {"root_ca_certificate": str(certificates["other"])})
-    assert_never_delivered(ZenohRobot("r1", connect=[endpoint], config_file=distrusting), delivered)
+    assert_never_delivered(ZenohRobot("r1", connect=[endpoint], config_file=distrusting, token=TOKEN), delivered)
 
 
 def test_with_mutual_tls_a_robot_with_a_certificate_of_the_authority_reaches_the_dashboard(certificates,
@@ -134,7 +134,7 @@ def test_with_mutual_tls_a_robot_with_a_certificate_of_the_authority_reaches_the
                                                      "enable_mtls": True,
                                                      "connect_certificate": str(certificates["robot_certificate"]),
                                                      "connect_private_key": str(certificates["robot_key"])})
-    robot = ZenohRobot("r1", connect=[endpoint], config_file=identified)
+    robot = ZenohRobot("r1", connect=[endpoint], config_file=identified, token=TOKEN)
     try:
         own = run_published(robot)
         wait_for(lambda: delivered and delivered[-1]["seq"] == own[-1]["seq"], 10, what="the last event over mTLS")
@@ -145,7 +145,7 @@ def test_with_mutual_tls_a_robot_with_a_certificate_of_the_authority_reaches_the
 def test_with_mutual_tls_a_robot_without_a_certificate_never_reaches_the_dashboard(certificates, mutual_dashboard):
     endpoint, delivered = mutual_dashboard
     anonymous = config_file(certificates, "anonymous", {"root_ca_certificate": str(certificates["ca"])})
-    assert_never_delivered(ZenohRobot("r1", connect=[endpoint], config_file=anonymous), delivered)
+    assert_never_delivered(ZenohRobot("r1", connect=[endpoint], config_file=anonymous, token=TOKEN), delivered)
 
 
 def test_a_zenoh_configuration_file_that_cannot_be_read_is_refused_with_why(tmp_path):

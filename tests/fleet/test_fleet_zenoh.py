@@ -12,36 +12,14 @@ from typing import Callable
 
 import fsm
 import pytest
-import zenoh
-from fleet_support import Proxy, free_endpoint, run_published, slow_loop
+from fleet_support import TOKEN, Delivered, Proxy, free_endpoint, run_published, slow_loop
 
 import fleet.robot
-from fleet.config import session_config
 from fleet.robot import ZenohRobot
-from fleet.watcher import FleetWatcher
 from fsm.control.handle import MachineHandle
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 from server.testing.polling import wait_for
-
-
-class Dashboard:
-    """What a watcher delivered: the events, in order, and each machine's comings and goings."""
-
-    def __init__(self, **session) -> None:
-        self.events: list[dict] = []
-        self.alive: list[tuple[str, bool]] = []
-        self.watcher = FleetWatcher(self.events.extend, lambda name, up: self.alive.append((name, up)), **session)
-
-    def status(self, name: str) -> Status:
-        """The machine's state rebuilt from what was delivered: from its last snapshot (or its first
-        event), the events."""
-        events = [event for event in self.events if event["machine"] == name]
-        start = max([i for i, event in enumerate(events) if event["kind"] == "snapshot"], default=0)
-        status = Status(name)
-        for event in events[start:]:
-            status.apply(event)
-        return status
 
 
 @pytest.fixture
@@ -68,8 +46,8 @@ def own_status(events: list[dict]) -> dict:
 
 def test_a_dashboard_there_first_gets_every_event_in_order(quiet):
     endpoint = free_endpoint()
-    dash = Dashboard(listen=[endpoint])
-    robot = ZenohRobot("r1", connect=[endpoint])
+    dash = Delivered(listen=[endpoint])
+    robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
     try:
         own = run_on(robot, slow_loop(60))
         wait_for(lambda: dash.events and dash.events[-1]["seq"] == own[-1]["seq"], 10,
@@ -83,14 +61,14 @@ def test_a_dashboard_there_first_gets_every_event_in_order(quiet):
         dash.watcher.close()
 
 
-def run_then_join() -> tuple[list[dict], Dashboard]:
+def run_then_join() -> tuple[list[dict], Delivered]:
     """A robot runs its machine to the end, then a dashboard joins: the robot's own events, and the
     dashboard with what it was given first."""
     endpoint = free_endpoint()
-    robot = ZenohRobot("r1", listen=[endpoint])
+    robot = ZenohRobot("r1", listen=[endpoint], token=TOKEN)
     try:
         own = run_on(robot, slow_loop(10, 0.0))
-        dash = Dashboard(connect=[endpoint])
+        dash = Delivered(connect=[endpoint])
         try:
             wait_for(lambda: dash.events, 10, what="the machine")
         finally:
@@ -117,14 +95,14 @@ def test_a_dashboard_that_joins_after_the_robot_let_the_runs_start_go_gets_its_e
 
 def test_a_robot_that_leaves_is_seen_gone_and_seen_back(quiet):
     endpoint = free_endpoint()
-    dash = Dashboard(listen=[endpoint])
+    dash = Delivered(listen=[endpoint])
     try:
-        robot = ZenohRobot("r1", connect=[endpoint])
+        robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
         run_on(robot, slow_loop(4, 0.0))
         wait_for(lambda: ("r1:loop", True) in dash.alive, 10, what="the machine seen")
         robot.close()
         wait_for(lambda: dash.alive[-1] == ("r1:loop", False), 10, what="the machine seen gone")
-        again = ZenohRobot("r1", connect=[endpoint])
+        again = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
         try:
             run_on(again, slow_loop(4, 0.0))
             wait_for(lambda: dash.alive[-1] == ("r1:loop", True), 10, what="the machine seen back")
@@ -137,13 +115,13 @@ def test_a_robot_that_leaves_is_seen_gone_and_seen_back(quiet):
 def test_a_robot_back_as_a_new_process_is_shown_from_a_new_snapshot(quiet):
     """Its seqs start again: what the dashboard shows is the new process's run, not the old one's."""
     endpoint = free_endpoint()
-    dash = Dashboard(listen=[endpoint])
+    dash = Delivered(listen=[endpoint])
     try:
-        with ZenohRobot("r1", connect=[endpoint]) as robot:
+        with ZenohRobot("r1", connect=[endpoint], token=TOKEN) as robot:
             run_on(robot, slow_loop(40, 0.0))
             wait_for(lambda: dash.events and dash.events[-1]["seq"] > 40, 10, what="the first process's run")
         wait_for(lambda: dash.alive[-1] == ("r1:loop", False), 10, what="the machine seen gone")
-        with ZenohRobot("r1", connect=[endpoint]) as again:
+        with ZenohRobot("r1", connect=[endpoint], token=TOKEN) as again:
             own = run_on(again, slow_loop(4, 0.0))
             wait_for(lambda: dash.status("r1:loop").last_seq == own[-1]["seq"], 10,
                      what=lambda: "the new run: %r" % [(e["kind"], e["seq"]) for e in dash.events[-5:]])
@@ -167,12 +145,12 @@ def test_the_last_events_of_a_run_put_while_the_dashboard_joins_reach_it(quiet):
     them to show the gap, so the join asks for them itself."""
     endpoint = free_endpoint()
     gate = threading.Event()
-    with ZenohRobot("r1", listen=[endpoint]) as robot:
+    with ZenohRobot("r1", listen=[endpoint], token=TOKEN) as robot:
         own, runner = run_published(robot, gated_machine(gate))
         wait_for(lambda: own and own[-1]["kind"] == "transition" and own[-1]["to"] == "WAIT", 10,
                  what="the machine waiting at its gate")
         robot.flush()
-        dash = Dashboard(connect=[endpoint])
+        dash = Delivered(connect=[endpoint])
         answered = dash.watcher._history
 
         def history_then_the_runs_end(*query):
@@ -192,14 +170,14 @@ def test_the_last_events_of_a_run_put_while_the_dashboard_joins_reach_it(quiet):
 
 
 @contextlib.contextmanager
-def a_run_cut_for_a_second(before_the_cut: Callable[[Dashboard], None] = lambda dash: None):
+def a_run_cut_for_a_second(before_the_cut: Callable[[Delivered], None] = lambda dash: None):
     """r1's machine (300 ticks of 10 ms) followed by a dashboard whose connection to it is cut for 1 s
     once 20 events came (``before_the_cut(dash)`` is called then), and restored: yields the dashboard
     and the robot's own events once the dashboard has the run's last one."""
     endpoint = free_endpoint()
-    dash = Dashboard(listen=[endpoint])
+    dash = Delivered(listen=[endpoint])
     proxy = Proxy(endpoint)
-    robot = ZenohRobot("r1", connect=[proxy.endpoint])
+    robot = ZenohRobot("r1", connect=[proxy.endpoint], token=TOKEN)
     try:
         sm = slow_loop(300, 0.01)
         own: list[dict] = []
@@ -219,7 +197,7 @@ def a_run_cut_for_a_second(before_the_cut: Callable[[Dashboard], None] = lambda 
         dash.watcher.close()
 
 
-def every_event_after_the_first(dash: Dashboard, own: list[dict]) -> bool:
+def every_event_after_the_first(dash: Delivered, own: list[dict]) -> bool:
     first = dash.events[0]["seq"]
     return [e["seq"] for e in dash.events[1:]] == [e["seq"] for e in own if e["seq"] > first]
 
@@ -234,7 +212,7 @@ def test_a_connection_cut_and_restored_while_the_machine_runs_leaves_no_gap(quie
 def test_a_gap_whose_history_the_robot_did_not_answer_in_time_is_filled_later_not_jumped(quiet):
     unanswered = []
 
-    def first_two_unanswered(dash: Dashboard) -> None:
+    def first_two_unanswered(dash: Delivered) -> None:
         answered = dash.watcher._history
 
         def history(*query):
@@ -252,7 +230,7 @@ def test_a_gap_whose_history_the_robot_did_not_answer_in_time_is_filled_later_no
 def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answers_from_its_status(quiet):
     """As `fsmscope run --zenoh` composes it (the hub is the host): the robot observes nothing itself."""
     endpoint = free_endpoint()
-    robot = ZenohRobot("r1", listen=[endpoint])
+    robot = ZenohRobot("r1", listen=[endpoint], token=TOKEN)
     host = Status("loop")
     lock = threading.Lock()
     own: list[dict] = []
@@ -267,7 +245,7 @@ def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answe
             take((event["seq"], dumps(event)))
 
         reporter.add_observer(host_observer)
-        dash = Dashboard(connect=[endpoint])
+        dash = Delivered(connect=[endpoint])
         try:
             wait_for(lambda: ("r1:loop", True) in dash.alive and dash.events, 10, what="the machine's snapshot")
             sm.execute()
@@ -283,8 +261,8 @@ def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answe
 
 def test_two_dashboards_watch_the_same_robot_and_each_gets_every_event(quiet):
     first, second = free_endpoint(), free_endpoint()
-    dashes = [Dashboard(listen=[first]), Dashboard(listen=[second])]
-    robot = ZenohRobot("r1", connect=[first, second])
+    dashes = [Delivered(listen=[first]), Delivered(listen=[second])]
+    robot = ZenohRobot("r1", connect=[first, second], token=TOKEN)
     try:
         own = run_on(robot, slow_loop(60))
         for dash in dashes:
@@ -296,68 +274,8 @@ def test_two_dashboards_watch_the_same_robot_and_each_gets_every_event(quiet):
             dash.watcher.close()
 
 
-@pytest.fixture
-def followed(quiet):
-    """A dashboard following r1's machine (50 events/s), a stranger's session on its network, and what
-    the machine's observer was given (the robot's own events)."""
-    endpoint = free_endpoint()
-    dash = Dashboard(listen=[endpoint])
-    robot = ZenohRobot("r1", connect=[endpoint])
-    stranger = zenoh.open(session_config(connect=[endpoint]))
-    sm = slow_loop(100_000, 0.02)
-    own, runner = run_published(robot, sm)
-    try:
-        wait_for(lambda: len(dash.events) >= 5, 10, what="the machine followed")
-        yield dash, stranger, own
-    finally:
-        sm.request_preempt()
-        runner.join(10)
-        robot.close()
-        stranger.close()
-        dash.watcher.close()
-
-
-def still_followed(dash: Dashboard) -> None:
-    """The machine's next 10 events come within 2.5 s: no query of a robot that is not there (each
-    waits 5 s for an answer) held the dashboard up."""
-    count = len(dash.events)
-    wait_for(lambda: len(dash.events) >= count + 10, 2.5, what="the machine still followed")
-
-
-def test_a_put_that_is_not_a_robots_is_counted_and_the_watcher_follows_on(followed):
-    dash, stranger, own = followed
-    for payload in (b"not json", b'{"seq": 1}', b'[{"no": "seq"}]'):
-        stranger.put("fsmscope/r1/loop/events", payload)
-    wait_for(lambda: dash.watcher.rejected == 3, 10, what="the three puts rejected")
-    still_followed(dash)
-    robot_seqs = [event["seq"] for event in own]
-    assert [event["seq"] for event in dash.events] == robot_seqs[:len(dash.events)]
-
-
-def test_events_put_for_a_machine_that_never_announced_itself_are_skipped_at_once(followed):
-    dash, stranger, _ = followed
-    before = dash.watcher.unannounced  # r1's first events may have come before its token did
-    stranger.put("fsmscope/ghost/m/events", b'[{"seq": 7}]')
-    still_followed(dash)
-    assert dash.watcher.unannounced == before + 1
-    assert not any(event["machine"] == "ghost:m" for event in dash.events)
-
-
-def test_a_token_that_no_robot_answers_for_holds_up_no_other_machine(followed):
-    dash, stranger, _ = followed
-    token = stranger.liveliness().declare_token("fsmscope/ghost/m")
-    try:
-        wait_for(lambda: ("ghost:m", True) in dash.alive, 10, what="the stranger's token seen")
-        still_followed(dash)
-        stranger.put("fsmscope/ghost/m/events", b'[{"seq": 7}]')  # alive, not joined: asks its join again
-        still_followed(dash)
-    finally:
-        token.undeclare()
-    assert not any(event["machine"] == "ghost:m" for event in dash.events)
-
-
 def test_a_closed_robot_keeps_no_more_than_a_batch_of_what_its_machine_still_does(quiet):
-    robot = ZenohRobot("r1")
+    robot = ZenohRobot("r1", token=TOKEN)
     sm = slow_loop(400, 0.0)
     fsm.attach(sm, robot, name="loop")
     sm.execute()
@@ -368,7 +286,7 @@ def test_a_closed_robot_keeps_no_more_than_a_batch_of_what_its_machine_still_doe
 
 
 def test_a_machine_that_first_runs_after_its_robot_closed_runs_unpublished(quiet):
-    robot = ZenohRobot("r1")
+    robot = ZenohRobot("r1", token=TOKEN)
     sm = slow_loop(4, 0.0)
     fsm.attach(sm, robot, name="loop")
     robot.close()

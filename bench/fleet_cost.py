@@ -59,7 +59,7 @@ from fleet.watcher import FleetWatcher
 seen = [0]
 def count(events):
     seen[0] += len(events)
-FleetWatcher(count, lambda name, up: None, listen=[sys.argv[1]])
+FleetWatcher(count, lambda name, up: None, listen=[sys.argv[1]], tokens={None: "bench"})
 print("listening", flush=True)
 threading.Event().wait()
 """
@@ -134,8 +134,8 @@ def loop_once(case: str, transitions: int, endpoint: str) -> None:
     fleet.robot.LINGER = 1.0  # callgrind slows the loop: batches as full as at full speed (MAX_BATCH)
     fsm.set_loggers(*[lambda msg: None] * 4)
     srv = ServerThread().start()
-    make = {"base": None, "quiet": lambda: ZenohRobot("bench"),
-            "followed": lambda: ZenohRobot("bench", connect=[endpoint])}[case]
+    make = {"base": None, "quiet": lambda: ZenohRobot("bench", token="bench"),
+            "followed": lambda: ZenohRobot("bench", connect=[endpoint], token="bench")}[case]
     robot = make() if make else None
     rate(srv, robot, joining=10.0)  # the join's answers, slowed too, are over before the timed run
     if robot is not None:
@@ -197,8 +197,8 @@ def main() -> None:
     endpoint = free_endpoint()
     watcher = spawn(WATCHER, endpoint)
     try:
-        alone = ZenohRobot("bench")  # nobody listens to it
-        watched = ZenohRobot("bench2", connect=[endpoint])
+        alone = ZenohRobot("bench", token="bench")  # nobody listens to it
+        watched = ZenohRobot("bench2", connect=[endpoint], token="bench")
         cases = {"base": lambda: rate(srv, None), "quiet": lambda: rate(srv, alone),
                  "followed": lambda: followed_rate(srv, watched, watcher, watcher_cpu),
                  "burnt": lambda: burnt_rate(srv, statistics.median(watcher_cpu or [0.25]))}

@@ -4,11 +4,14 @@ answers with the event it caused; nothing without the robot's token controls its
 
 from __future__ import annotations
 
+import time
 
 import fsm
 import pytest
+import zenoh
 from fleet_support import TOKEN, free_endpoint, run_published, slow_loop
 
+from fleet.config import session_config
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from server.testing.polling import wait_for
@@ -92,3 +95,40 @@ def test_the_robot_applies_the_deadman_when_the_dashboard_holding_the_lease_is_g
     assert [(e["action"], e["client"]) for e in controls_of(own)] == [("deadman", "robot"), ("preempt", "robot")]
     [deadman] = [e for e in controls_of(own) if e["action"] == "deadman"]
     assert deadman["params"] == {"after": 0.3, "then": "preempt"} and watcher.id in deadman["reason"]
+
+
+def test_a_strangers_beats_do_not_keep_a_gone_dashboards_lease():
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    endpoint, dashboards = free_endpoint(), free_endpoint()
+    robot = ZenohRobot("r1", listen=[endpoint], token=TOKEN)
+    watcher = FleetWatcher(lambda events: None, lambda name, up: None, connect=[endpoint], listen=[dashboards],
+                           tokens={None: TOKEN})
+    stranger = zenoh.open(session_config(connect=[endpoint, dashboards]))  # hears the beats; stays when the dashboard goes
+    sm = slow_loop(100_000, 0.02)
+    own, runner = run_published(robot, sm)
+    wait_for(lambda: watcher.controls.get("r1:loop"), 10, what="the robot's machine joined, taking controls")
+    beats: list[tuple[str, bytes, bytes]] = []
+    heard = stranger.declare_subscriber("fsmscope-dashboards/**", lambda sample: beats.append(
+        (str(sample.key_expr), sample.payload.to_bytes(), sample.attachment.to_bytes())))
+    lease = {"held": True, "after": 0.3, "action": "preempt"}
+    assert watcher.ask("r1", "loop", TOKEN, "lease", lease, "operator") == {"status": 200}
+    wait_for(lambda: len(beats) >= 3, 10, what="the dashboard's beats heard")
+    watcher.close()
+    heard.undeclare()
+    presence = stranger.liveliness().declare_token("fsmscope-dashboards/" + watcher.id)  # what stood for it before
+    try:
+        gone = time.monotonic()
+        while not any(e["kind"] == "terminate" for e in own):  # the beats played again, forged ones between
+            assert time.monotonic() - gone < 8, "the deadman did not fire while a stranger played the beats"
+            for key, payload, proof in beats:
+                stranger.put(key, payload, attachment=proof)
+                stranger.put(key, b"999999", attachment=proof)
+            time.sleep(0.1)
+    finally:
+        presence.undeclare()
+        stranger.close()
+        sm.request_preempt()
+        runner.join(10)
+        robot.close()
+    assert [(e["action"], e["client"]) for e in controls_of(own)] == [("deadman", "robot"), ("preempt", "robot")]
+    assert robot.controls.refused >= 10  # the forged beats, said

@@ -21,10 +21,10 @@ def followed():
     """A dashboard following r1's machine (50 events/s), a stranger's session on its network, and what
     the machine's observer was given (the robot's own events)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
-    endpoint = free_endpoint()
+    endpoint, robots = free_endpoint(), free_endpoint()
     dash = Delivered(listen=[endpoint])
-    robot = ZenohRobot("r1", connect=[endpoint], token=TOKEN)
-    stranger = zenoh.open(session_config(connect=[endpoint]))
+    robot = ZenohRobot("r1", connect=[endpoint], listen=[robots], token=TOKEN)
+    stranger = zenoh.open(session_config(connect=[endpoint, robots]))  # reaches the dashboard and the robot
     sm = slow_loop(100_000, 0.02)
     own, runner = run_published(robot, sm)
     try:
@@ -122,3 +122,52 @@ def test_sixty_machines_nobody_answers_for_hold_no_new_robot_off(followed):
         queryable.undeclare()
         for query in waiting:
             query.drop()
+
+
+def controls_of(events: list[dict]) -> list[dict]:
+    return [event for event in events if event["kind"] == "control"]
+
+
+def test_a_strangers_queryable_on_the_control_key_gets_no_token_and_its_answer_is_refused(followed):
+    dash, stranger, own, robot, _ = followed
+    taken: list[tuple[bytes, bytes]] = []
+
+    def answer_for_the_robot(query: zenoh.Query) -> None:
+        if query.payload is not None:  # not the test's own query below
+            taken.append((query.payload.to_bytes(), query.attachment.to_bytes()))
+        query.reply(query.key_expr, b'{"status": 202, "seq": 1}', attachment=bytes(32))
+
+    queryable = stranger.declare_queryable("fsmscope/r1/loop/control", answer_for_the_robot, complete=True)
+    try:
+        wait_for(lambda: list(dash.watcher.session.get("fsmscope/r1/loop/control", timeout=1.0,
+                                                       target=zenoh.QueryTarget.ALL_COMPLETE)), 10,
+                 what="the dashboard knows the stranger's queryable")
+        answer = dash.watcher.ask("r1", "loop", TOKEN, "preempt", {"reason": "the operator's"}, "operator")
+        [control] = controls_of(own)
+        assert (answer["status"], answer["seq"]) == (202, control["seq"])  # the robot's answer, not the stranger's
+        wait_for(lambda: taken, 5, what="the stranger's queryable asked too")  # in its own thread
+        [(payload, proof)] = taken
+        assert TOKEN.encode() not in payload + proof
+        assert list(stranger.get("fsmscope/r1/loop/control", payload=payload, attachment=proof, timeout=5.0))
+        assert robot.controls.refused == 1 and len(controls_of(own)) == 1  # played again: refused
+    finally:
+        queryable.undeclare()
+
+
+def test_a_strangers_answer_alone_is_no_answer(followed):
+    dash, stranger, _, _, _ = followed
+    queryable = stranger.declare_queryable(
+        "fsmscope/r9/loop/control", lambda query: query.reply(query.key_expr, b'{"status": 202, "seq": 1}'))
+    try:
+        assert dash.watcher.ask("r9", "loop", TOKEN, "preempt", {}, "operator") is None
+    finally:
+        queryable.undeclare()
+
+
+def test_a_robot_says_the_controls_it_refuses_once_per_doubling_of_their_count(followed, capfd):
+    _, stranger, own, robot, _ = followed
+    for i in range(300):
+        list(stranger.get("fsmscope/r1/loop/control", payload=b'{"token": "a guess %d"}' % i, timeout=5.0))
+    lines = [line for line in capfd.readouterr().err.splitlines() if "refused" in line]
+    assert robot.controls.refused == 300 and len(lines) == 9  # the 1st, 2nd, 4th, ... 256th
+    assert controls_of(own) == []

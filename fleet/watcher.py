@@ -21,10 +21,10 @@ what they read one at a time, under one lock. The events' reader delivers, and a
 follows for a gap; no other hop is taken per batch (each costs a fleet's dashboard more than the
 batch's events do). A reader handles what its channel holds before it says ``settled``: the robots
 put on the same tick, and the dashboard's loop is woken once for them. A third thread joins the
-machines: it sends the state queries of up to ``MAX_JOINS`` machines at once without waiting for
-them (their answers come back to it), and asks a machine's history once its state answered, without
-the lock: a machine that answers slowly, or a stranger's token that nobody answers for, never holds
-up the events or the joins of the others. Events of a
+machines (fleet/joins.py): it sends their state queries without waiting for them, and asks a
+machine's history once its state answered, without the lock: a machine that answers slowly, or a
+stranger's token that nobody answers for, never holds up the events or the joins of the others.
+Events of a
 machine whose token was never seen are skipped (anyone on the network can put on these keys: asking
 for each would let one put a second stop the dashboard for five); those of a machine alive but not
 joined yet ask its join again, at most once per ``JOIN_AGAIN``, and are asked for from its history
@@ -41,13 +41,14 @@ batch moves the dashboard's idea of its sequence by more than the events it hold
 What each robot said of a machine's controls with its snapshot is kept in ``controls``; ``ask``
 sends a control to the machine's robot (fleet/control.py). While it leases a robot's machine, the
 watcher beats for it (fleet/beats.py).
+
+One piece over 300 lines: its readers and its joins share one lock and one idea of each machine
+(the last seq delivered, the robot's process, the events skipped), which a split would pass around.
 """
 
 from __future__ import annotations
 
-import collections
 import itertools
-import queue
 import sys
 import threading
 from time import monotonic
@@ -61,13 +62,12 @@ from fsm.observation.encoding import loads
 from . import control, keys, proofs
 from .beats import Heartbeats
 from .config import open_session
-from .query import first_reply, send
+from .joins import QUERY_TIMEOUT, Joins
+from .query import first_reply
 
-QUERY_TIMEOUT = 5.0  # seconds a state or history query waits for the robot's answer
 QUEUE = 10_000  # samples waiting in a channel for the watcher's thread before the oldest are dropped
 BURST = 64  # samples handled at most before ``settled`` is called, when they keep coming
 JOIN_AGAIN = 1.0  # seconds before the events of a machine alive but not joined ask its join again
-MAX_JOINS = 256  # machines whose state query is on its way at once; more wait for their turn
 
 
 def fleet_name(robot: str, machine: str) -> str:
@@ -97,12 +97,7 @@ class FleetWatcher:
         self._alive: set[str] = set()  # machines whose liveliness token is up
         self._asked: dict[str, float] = {}  # machine -> when its join was last asked for
         self._skipped: set[str] = set()  # machines whose events came while their join was on its way
-        # Machine keys to join, and state answers (key, answer) for the joins' thread; None: stop.
-        self._joins: queue.SimpleQueue[str | tuple[str, bytes | None] | None] = queue.SimpleQueue()
-        self._joining: set[str] = set()  # keys whose state query is on its way (the joins' thread's)
-        self._waiting: collections.deque[str] = collections.deque()  # keys past MAX_JOINS, in turn
         self._counter = itertools.count(1)  # of this dashboard's controls: a robot takes each once
-        self._cancel = zenoh.CancellationToken()  # the joins' state queries on their way, at close
         self.gaps_filled = 0
         self.snapshots = 0
         self.backfilled = 0  # machines taken from their first event
@@ -112,6 +107,7 @@ class FleetWatcher:
         self.unannounced = 0  # event samples skipped: their machine's token was never seen
         self.id = str(self.session.zid())
         self.beats = Heartbeats(self.session, self.id)
+        self._joins = Joins(self.session, self._token, lambda item: self._handle(self._join, item), self.settled)
         # Channels read by threads of ours (daemons: a callback's thread of Zenoh's would keep the
         # process from ending); the events' channel drops the oldest when full (the gap is filled after).
         self._events = self.session.declare_subscriber(keys.ALL_EVENTS, zenoh.handlers.RingChannel(QUEUE))
@@ -121,15 +117,13 @@ class FleetWatcher:
                                        ("tokens", self._tokens, self._on_token)):
             threading.Thread(target=self._read, args=(subscriber, read), name="fsmscope-fleet-" + name,
                              daemon=True).start()
-        threading.Thread(target=self._join_all, name="fsmscope-fleet-joins", daemon=True).start()
         closing.close_at_exit(self)
 
     def close(self) -> None:
         if self._closed:
             return
         self._closed = True
-        self._joins.put(None)
-        self._cancel.cancel()
+        self._joins.close()
         self.beats.close()
         self._tokens.undeclare()
         self._events.undeclare()
@@ -165,36 +159,6 @@ class FleetWatcher:
         """Samples and answers that proved their robot's token but were not what a robot sends."""
         return self.rejections.count
 
-    def _join_all(self) -> None:
-        """The joins' thread: each machine key asked for gets its state query sent (``MAX_JOINS`` on
-        their way at most); each state answer is joined (its history asked, waiting without the lock)."""
-        try:
-            while (item := self._joins.get()) is not None:
-                if type(item) is str:
-                    self._send_join(item)
-                    continue
-                key, answer = item
-                self._joining.discard(key)
-                while self._waiting and len(self._joining) < MAX_JOINS:
-                    self._send_join(self._waiting.popleft())
-                if answer is not None:
-                    self._handle(self._join, (key, answer))
-                    self.settled()
-        except zenoh.ZError:  # the session closed
-            pass
-
-    def _send_join(self, key: str) -> None:
-        """In the joins' thread: the machine's state query, unless one is on its way (or waits)."""
-        if key in self._joining or key in self._waiting:
-            return
-        if len(self._joining) >= MAX_JOINS:
-            self._waiting.append(key)
-            return
-        self._joining.add(key)
-        robot, machine = keys.split(key)
-        send(self.session, keys.state_key(robot, machine), self._token(robot), QUERY_TIMEOUT,
-             lambda answer: self._joins.put((key, answer)), cancel=self._cancel)
-
     def _token(self, robot: str) -> str | None:
         """The token this dashboard holds for ``robot``'s proofs."""
         return self.tokens.get(robot, self.tokens.get(None))
@@ -214,7 +178,7 @@ class FleetWatcher:
     def _ask_join(self, name: str, key: str) -> None:
         """Under the lock: have the joins' thread join the machine."""
         self._asked[name] = monotonic()
-        self._joins.put(key)
+        self._joins.ask(key)
 
     # The readers' threads.
     def _on_token(self, sample: zenoh.Sample) -> None:

@@ -12,9 +12,12 @@ import time
 
 import fsm
 import pytest
+import zenoh
 from fleet_support import (TOKEN, ROOT, Dashboard, Proxy, Robot, free_endpoint, preempted_the_dashboard_has_the_robots_log,
                            run_published, slow_loop, stop)
 
+from fleet import keys
+from fleet.config import session_config
 from fleet.robot import ZenohRobot
 from fleet.watcher import FleetWatcher
 from fsm.logfiles.log_reader import read_events
@@ -207,3 +210,25 @@ def test_a_script_that_never_closes_its_robot_still_exits(tmp_path):
     done = subprocess.run([sys.executable, str(script)], cwd=ROOT, capture_output=True, text=True, timeout=30,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert done.returncode == 0, done.stderr
+
+
+def test_a_strangers_answer_to_a_control_is_not_what_the_dashboard_answers(dashboard_with):
+    dash = dashboard_with("--zenoh-token", TOKEN)
+    robot, own, runner = running_robot(dash.endpoint, TOKEN)
+    stranger = zenoh.open(session_config(connect=[dash.endpoint]))
+    try:
+        wait_for(lambda: dash.machines().get("r1:loop", {}).get("controllable"), 15, what="r1:loop controllable")
+        cut_off = robot._machines["loop"]  # the robot's controls cut off: only the stranger answers
+        cut_off.control.undeclare()
+        cut_off.control = robot.session.declare_queryable(keys.control_key("r1", "loop"), lambda query: query.drop())
+        forged = stranger.declare_queryable(keys.control_key("r1", "loop"), complete=True, handler=lambda query: (
+            query.reply(query.key_expr, b'{"status": 202, "seq": 1}'), query.drop()))
+        answer = dash.post("/api/machines/r1:loop/preempt", {})
+        assert answer.status_code == 504 and "no authenticated answer from robot 'r1'" in answer.json()["detail"]
+        assert runner.is_alive() and not [e for e in own if e["kind"] == "control"]
+        forged.undeclare()
+    finally:
+        stranger.close()
+        robot.controls.handles["loop"].preempt(None, "test")
+        runner.join(10)
+        robot.close()

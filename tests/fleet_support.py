@@ -5,6 +5,7 @@ robots/patrol.py --zenoh ROBOT``) and routers (``fsmscope router``)."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import signal
@@ -275,3 +276,25 @@ class Delivered:
         for event in events[start:]:
             status.apply(event)
         return status
+
+
+EVERY_MESSAGE = ["put", "delete", "declare_subscriber", "query", "declare_queryable", "reply", "liveliness_token",
+                 "declare_liveliness_subscriber", "liveliness_query"]  # zenoh-config's AclMessage, all of them
+
+
+def access_configuration(directory: Path, name: str, passwords: dict[str, str], access_control: dict) -> str:
+    """A Zenoh configuration file (``name``.json5 in ``directory``) that checks each session's user
+    and password against ``passwords`` (its dictionary file beside it) and applies ``access_control``."""
+    users = directory / (name + "-users.txt")
+    users.write_text("".join("%s:%s\n" % item for item in passwords.items()))
+    path = directory / (name + ".json5")
+    path.write_text(json.dumps({"transport": {"auth": {"usrpwd": {"dictionary_file": str(users)}}},
+                                "access_control": access_control}, indent=2))
+    return str(path)
+
+
+def user_configuration(directory: Path, user: str, password: str) -> str:
+    """A Zenoh configuration file that opens a session as ``user`` with ``password``."""
+    path = directory / ("user-%s-%s.json5" % (user, password))
+    path.write_text(json.dumps({"transport": {"auth": {"usrpwd": {"user": user, "password": password}}}}))
+    return str(path)

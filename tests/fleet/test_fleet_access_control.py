@@ -4,9 +4,9 @@ user-password authentication (``transport/auth/usrpwd``: the robot checks each s
 password against its dictionary file) and an ``access_control`` block naming what each user may do.
 User "operator" may do everything on the fleet's keys; user "viewer" may watch (subscribe to the
 events and the liveliness tokens, query ``.../state`` and ``.../history``), and its queries on
-``.../control`` are denied: whatever token a control carries, the robot's Zenoh drops it before
-fsmscope sees it. The operator's dashboard, holding a lease, is watched for the deadman (its
-liveliness token, outside ``fsmscope/``, has its own key expression in the operator's rule). A
+``.../control`` are denied: whatever token a control proves, the robot's Zenoh drops it before
+fsmscope sees it. The operator's dashboard, holding a lease, is followed for the deadman (its
+heartbeats, outside ``fsmscope/``, have their own key expression in the operator's rule). A
 session whose password is wrong is not let in at all. Zenoh's ACL says all of this as it is;
 docs/fleet.md shows the same file.
 
@@ -21,14 +21,13 @@ ends as "no answer" (None; the dashboard's 504) after the watcher's QUERY_TIMEOU
 
 from __future__ import annotations
 
-import json
 import time
 from pathlib import Path
 from types import SimpleNamespace
 
 import fsm
 import pytest
-from fleet_support import TOKEN, Dashboard, free_endpoint, run_published, slow_loop
+from fleet_support import TOKEN, EVERY_MESSAGE, Dashboard, access_configuration, user_configuration, free_endpoint, run_published, slow_loop
 
 from fleet import control, keys
 from fleet.robot import ZenohRobot
@@ -36,50 +35,34 @@ from fleet.watcher import FleetWatcher
 from server.testing.polling import wait_for
 
 PASSWORDS = {"operator": "operator-secret", "viewer": "viewer-secret"}
-EVERY_MESSAGE = ["put", "delete", "declare_subscriber", "query", "declare_queryable", "reply", "liveliness_token",
-                 "declare_liveliness_subscriber", "liveliness_query"]  # zenoh-config's AclMessage, all of them
 NAME = "r1:loop"
 
 
 def robot_configuration(directory: Path) -> str:
     """The robot's Zenoh configuration file (docs/fleet.md shows it): the users' dictionary, and what
     each may do; anything no rule allows is denied."""
-    users = directory / "users.txt"
-    users.write_text("".join("%s:%s\n" % item for item in PASSWORDS.items()))
-    configuration = {
-        "transport": {"auth": {"usrpwd": {"dictionary_file": str(users)}}},
-        "access_control": {
-            "enabled": True,
-            "default_permission": "deny",
-            "rules": [
-                # The dashboards' liveliness tokens too: the robot watches its operator's for the deadman.
-                {"id": "everything", "permission": "allow", "flows": ["ingress", "egress"],
-                 "messages": EVERY_MESSAGE, "key_exprs": ["fsmscope/**", "fsmscope-dashboards/**"]},
-                {"id": "watch", "permission": "allow", "flows": ["ingress"],
-                 "messages": ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query", "query"],
-                 "key_exprs": ["fsmscope/**"]},
-                {"id": "be watched", "permission": "allow", "flows": ["egress"],
-                 "messages": ["put", "delete", "reply", "liveliness_token", "declare_queryable"],
-                 "key_exprs": ["fsmscope/**"]},
-                # An explicit deny wins over an allow: no query on a machine's control key.
-                {"id": "no control", "permission": "deny", "flows": ["ingress"], "messages": ["query"],
-                 "key_exprs": ["fsmscope/*/*/control"]},
-            ],
-            "subjects": [{"id": "operators", "usernames": ["operator"]},
-                         {"id": "viewers", "usernames": ["viewer"]}],
-            "policies": [{"rules": ["everything"], "subjects": ["operators"]},
-                         {"rules": ["watch", "be watched", "no control"], "subjects": ["viewers"]}],
-        },
-    }
-    path = directory / "robot.json5"
-    path.write_text(json.dumps(configuration, indent=2))
-    return str(path)
-
-
-def dashboard_configuration(directory: Path, user: str, password: str) -> str:
-    path = directory / ("dashboard-%s-%s.json5" % (user, password))
-    path.write_text(json.dumps({"transport": {"auth": {"usrpwd": {"user": user, "password": password}}}}))
-    return str(path)
+    return access_configuration(directory, "robot", PASSWORDS, {
+        "enabled": True,
+        "default_permission": "deny",
+        "rules": [
+            # The dashboards' heartbeats too: the robot follows its operator's for the deadman.
+            {"id": "everything", "permission": "allow", "flows": ["ingress", "egress"],
+             "messages": EVERY_MESSAGE, "key_exprs": ["fsmscope/**", "fsmscope-dashboards/**"]},
+            {"id": "watch", "permission": "allow", "flows": ["ingress"],
+             "messages": ["declare_subscriber", "declare_liveliness_subscriber", "liveliness_query", "query"],
+             "key_exprs": ["fsmscope/**"]},
+            {"id": "be watched", "permission": "allow", "flows": ["egress"],
+             "messages": ["put", "delete", "reply", "liveliness_token", "declare_queryable"],
+             "key_exprs": ["fsmscope/**"]},
+            # An explicit deny wins over an allow: no query on a machine's control key.
+            {"id": "no control", "permission": "deny", "flows": ["ingress"], "messages": ["query"],
+             "key_exprs": ["fsmscope/*/*/control"]},
+        ],
+        "subjects": [{"id": "operators", "usernames": ["operator"]},
+                     {"id": "viewers", "usernames": ["viewer"]}],
+        "policies": [{"rules": ["everything"], "subjects": ["operators"]},
+                     {"rules": ["watch", "be watched", "no control"], "subjects": ["viewers"]}],
+    })
 
 
 @pytest.fixture
@@ -98,7 +81,7 @@ def fleet(tmp_path):
         seen: list[dict] = []
         alive: list[tuple[str, bool]] = []
         watcher = FleetWatcher(seen.extend, lambda name, up: alive.append((name, up)), connect=[endpoint],
-                               config_file=dashboard_configuration(tmp_path, user, password), tokens={None: TOKEN})
+                               config_file=user_configuration(tmp_path, user, password), tokens={None: TOKEN})
         watchers.append(watcher)
         return SimpleNamespace(watcher=watcher, seen=seen, alive=alive)
 
@@ -152,7 +135,7 @@ def test_a_viewers_control_is_never_applied_even_with_the_robots_token(fleet, mo
 
 def test_a_viewers_dashboard_answers_its_preempt_with_a_504_naming_the_access_control(fleet, tmp_path):
     dash = Dashboard("--zenoh", fleet.endpoint, "--zenoh-token", "r1=" + TOKEN,
-                     "--zenoh-config", dashboard_configuration(tmp_path, "viewer", PASSWORDS["viewer"]))
+                     "--zenoh-config", user_configuration(tmp_path, "viewer", PASSWORDS["viewer"]))
     try:
         wait_for(lambda: dash.machines().get(NAME, {}).get("running"), 15, what="the dashboard showing the machine")
         answer = dash.post("/api/machines/%s/preempt" % NAME, {})

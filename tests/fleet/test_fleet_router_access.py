@@ -7,55 +7,39 @@ the fleet's token, and a session without a password is not let in."""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import pytest
-from fleet_support import TOKEN, Dashboard, Robot, Router, preempted_the_dashboard_has_the_robots_log
+from fleet_support import (TOKEN, EVERY_MESSAGE, Dashboard, Robot, Router, access_configuration,
+                           preempted_the_dashboard_has_the_robots_log, user_configuration)
 
 from fleet.watcher import FleetWatcher
 from server.testing.polling import wait_for
 
 PASSWORDS = {"r1": "r1-secret", "operator": "operator-secret"}
-EVERY_MESSAGE = ["put", "delete", "declare_subscriber", "query", "declare_queryable", "reply", "liveliness_token",
-                 "declare_liveliness_subscriber", "liveliness_query"]  # zenoh-config's AclMessage, all of them
 
 
 def router_configuration(directory: Path) -> str:
     """The router's file (docs/fleet.md shows it): the users' dictionary; robot r1's user may do
     anything on r1's keys and its dashboards' heartbeats, the operator on the whole fleet's; anything
     no rule allows is denied."""
-    users = directory / "users.txt"
-    users.write_text("".join("%s:%s\n" % item for item in PASSWORDS.items()))
-    configuration = {
-        "transport": {"auth": {"usrpwd": {"dictionary_file": str(users)}}},
-        "access_control": {
-            "enabled": True,
-            "default_permission": "deny",
-            "rules": [
-                {"id": "robot r1", "permission": "allow", "flows": ["ingress", "egress"], "messages": EVERY_MESSAGE,
-                 "key_exprs": ["fsmscope/r1/**", "fsmscope-dashboards/*/r1"]},
-                # The dashboards' subscriptions (fsmscope/*/*/events) told to the robot: without them it
-                # puts nowhere, since Zenoh sends a put only towards a subscriber it knows of.
-                {"id": "hear of subscribers", "permission": "allow", "flows": ["egress"],
-                 "messages": ["declare_subscriber", "declare_liveliness_subscriber"], "key_exprs": ["fsmscope/**"]},
-                {"id": "dashboards", "permission": "allow", "flows": ["ingress", "egress"], "messages": EVERY_MESSAGE,
-                 "key_exprs": ["fsmscope/**", "fsmscope-dashboards/**"]},
-            ],
-            "subjects": [{"id": "r1", "usernames": ["r1"]}, {"id": "operators", "usernames": ["operator"]}],
-            "policies": [{"rules": ["robot r1", "hear of subscribers"], "subjects": ["r1"]},
-                         {"rules": ["dashboards"], "subjects": ["operators"]}],
-        },
-    }
-    path = directory / "router.json5"
-    path.write_text(json.dumps(configuration, indent=2))
-    return str(path)
-
-
-def user_configuration(directory: Path, user: str, password: str) -> str:
-    path = directory / ("%s-%s.json5" % (user, password))
-    path.write_text(json.dumps({"transport": {"auth": {"usrpwd": {"user": user, "password": password}}}}))
-    return str(path)
+    return access_configuration(directory, "router", PASSWORDS, {
+        "enabled": True,
+        "default_permission": "deny",
+        "rules": [
+            {"id": "robot r1", "permission": "allow", "flows": ["ingress", "egress"], "messages": EVERY_MESSAGE,
+             "key_exprs": ["fsmscope/r1/**", "fsmscope-dashboards/*/r1"]},
+            # The dashboards' subscriptions (fsmscope/*/*/events) told to the robot: without them it
+            # puts nowhere, since Zenoh sends a put only towards a subscriber it knows of.
+            {"id": "hear of subscribers", "permission": "allow", "flows": ["egress"],
+             "messages": ["declare_subscriber", "declare_liveliness_subscriber"], "key_exprs": ["fsmscope/**"]},
+            {"id": "dashboards", "permission": "allow", "flows": ["ingress", "egress"], "messages": EVERY_MESSAGE,
+             "key_exprs": ["fsmscope/**", "fsmscope-dashboards/**"]},
+        ],
+        "subjects": [{"id": "r1", "usernames": ["r1"]}, {"id": "operators", "usernames": ["operator"]}],
+        "policies": [{"rules": ["robot r1", "hear of subscribers"], "subjects": ["r1"]},
+                     {"rules": ["dashboards"], "subjects": ["operators"]}],
+    })
 
 
 @pytest.fixture

@@ -21,7 +21,7 @@ def _message(store, kind: str, fields: dict, t: float, ros2: bool, raw_pickle: b
     if kind == "structure":
         return store.types[smach_msgs.STRUCTURE](header=header, **fields)
     data = {k: v for k, v in fields.items() if k != "userdata"}
-    pickled = pickle.dumps(fields["userdata"], 2)
+    pickled = fields["userdata"] if isinstance(fields["userdata"], bytes) else pickle.dumps(fields["userdata"], 2)
     if ros2 or raw_pickle:
         data["local_data"] = numpy.frombuffer(pickled, dtype=numpy.uint8)
     else:
@@ -31,7 +31,7 @@ def _message(store, kind: str, fields: dict, t: float, ros2: bool, raw_pickle: b
 
 def write_bag(path: Path, layout: str, runs: list[tuple[float, str, str, dict]]) -> Path:
     """``runs``, (t, topic, kind "structure" or "status", fields; a status's ``userdata`` is pickled as
-    smach_ros does), written to a bag at ``path``: ``layout`` "ros1" (noetic: base64 of the pickle),
+    smach_ros does, or is the pickle when bytes), written to a bag at ``path``: ``layout`` "ros1" (noetic: base64 of the pickle),
     "ros1-raw" (the raw pickle of older releases), "ros2-sqlite3" or "ros2-mcap"."""
     ros2 = layout.startswith("ros2")
     raw = layout == "ros1-raw"

@@ -145,3 +145,47 @@ def test_a_humble_sqlite3_bag_without_message_definitions_reads_with_ours(tmp_pa
     with sqlite3.connect(next(bag.glob("*.db3"))) as db:  # Humble's rosbag2 stored no definitions
         db.execute("DELETE FROM message_definitions")
     assert events_of(bag) == noetic_events
+
+
+def with_userdata(userdata) -> list:
+    """The run, every status's userdata ``userdata`` (a value, or the pickle itself when bytes)."""
+    return [(t, topic, kind, dict(fields, userdata=userdata) if kind == "status" else fields)
+            for t, topic, kind, fields in messages()]
+
+
+def shared_levels(levels: int = 14, width: int = 10) -> list:
+    """A list of ``width`` references to a list of ... : 368 bytes as a pickle, ``width ** levels`` items written out."""
+    value: list = []
+    for _ in range(levels):
+        value = [value] * width
+    return value
+
+
+GIB = 1 << 30
+
+
+def test_import_and_replay_of_userdata_huge_only_when_written_out_take_little_memory_and_time(tmp_path):
+    bag = write_bag(tmp_path / "bomb.bag", "ros1", with_userdata({"bomb": shared_levels()}))
+    done = cli("import", bag, "-o", tmp_path / "bomb.jsonl", memory=GIB, timeout=60)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr[-2000:]
+    start = next(ev for ev in read_events(str(tmp_path / "bomb.jsonl")) if ev["kind"] == "start")
+    assert start["userdata"]["bomb"]["$truncated"] is True
+    replayed = cli("replay", bag, memory=GIB, timeout=60)
+    assert replayed.returncode == 0 and "Traceback" not in replayed.stderr, replayed.stderr[-2000:]
+
+
+def test_import_of_an_int_too_long_for_text_writes_a_marker(tmp_path):
+    bag = write_bag(tmp_path / "big.bag", "ros1", with_userdata({"big": 10 ** 5000}))
+    done = cli("import", bag, "-o", tmp_path / "big.jsonl")
+    assert done.returncode == 0, done.stderr[-2000:]
+    start = next(ev for ev in read_events(str(tmp_path / "big.jsonl")) if ev["kind"] == "start")
+    assert start["userdata"]["big"] == {"$repr": "<int of 16610 bits>"}
+
+
+def test_import_of_a_dict_key_nested_deeper_than_hashing_can_go_says_the_userdata_was_not_read(tmp_path):
+    key = b")" + b"\x85" * 1_000_000  # ((((...)))) a million deep, built opcode by opcode
+    bag = write_bag(tmp_path / "deep.bag", "ros1", with_userdata(b"\x80\x02}" + key + b"K\x01s."))
+    done = cli("import", bag, "-o", tmp_path / "deep.jsonl", memory=GIB, timeout=60)
+    assert done.returncode == 0, done.stderr[-2000:]
+    said = [ev["msg"] for ev in read_events(str(tmp_path / "deep.jsonl")) if ev["kind"] == "log"]
+    assert said and all("userdata not read: a pickle with a dict key or set item nested deeper" in m for m in said)

@@ -58,29 +58,34 @@ class _Walk:
             raise _Over
 
     def enc(self, value: Any, depth: int) -> Any:
+        """The encoding of ``value``; the bytes it takes are counted (a caller checks the room left)."""
         t = type(value)
-        if value is None or value is True or value is False:
-            self.take(4)
-            return value
         if t is str:
-            self.take(len(value) + 2)
+            self.room -= len(value) + 2
+            return value
+        if value is None or value is True or value is False:
+            self.room -= 4
             return value
         if t is int:
             if -(2 ** 63) <= value < 2 ** 64:
-                self.take(1)
+                self.room -= 1
                 return value
             text = _int_text(value)
             if text is None:
                 return self.opaque({"$repr": "<int of %d bits>" % value.bit_length()})
-            self.take(len(text) + 2)
+            self.room -= len(text) + 2
             return text
         if t is float:
-            self.take(1)
+            self.room -= 1
             if math.isfinite(value):
                 return value
             return "NaN" if value != value else ("Infinity" if value > 0 else "-Infinity")
+        if self.room < 0:
+            raise _Over
         if depth >= _MAX_DEPTH:
             return self.opaque(_marker(value))
+        if t is list or t is dict or t is tuple:
+            return self.container(value, depth)
         if isinstance(value, enum.Enum):
             return self.enc("%s.%s" % (type(value).__name__, value.name), depth)
         if isinstance(value, _CONTAINERS) or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
@@ -97,7 +102,7 @@ class _Walk:
         return self.opaque(_marker(value))
 
     def opaque(self, marker: dict) -> dict:
-        self.take(len(marker["$repr"]) + 12)
+        self.room -= len(marker["$repr"]) + 12
         return marker
 
     def container(self, value: Any, depth: int) -> Any:
@@ -110,23 +115,31 @@ class _Walk:
             return self.opaque({"$repr": _cycle(value)})
         self.open.add(id(value))
         before = self.room
-        self.take(2)
+        fields = None if isinstance(value, _CONTAINERS) else dataclasses.fields(value)
+        self.take(1 + max(len(value if fields is None else fields), 1))  # brackets and commas
+        enc = self.enc
+        inner = depth + 1
         if isinstance(value, dict):
             out: Any = {}
-            for i, (k, v) in enumerate(value.items()):
+            for k, v in value.items():
                 k = _key(k)
-                self.take(len(k) + 3 + (i > 0))
-                out[k] = self.enc(v, depth + 1)
+                self.room -= len(k) + 3
+                out[k] = enc(v, inner)
+                if self.room < 0:
+                    raise _Over
         elif isinstance(value, _CONTAINERS):
             out = []
-            for i, v in enumerate(value):
-                self.take(i > 0)
-                out.append(self.enc(v, depth + 1))
+            for v in value:
+                out.append(enc(v, inner))
+                if self.room < 0:
+                    raise _Over
         else:
             out = {}
-            for i, f in enumerate(dataclasses.fields(value)):
-                self.take(len(f.name) + 3 + (i > 0))
-                out[f.name] = self.enc(getattr(value, f.name, None), depth + 1)
+            for f in fields:
+                self.room -= len(f.name) + 3
+                out[f.name] = enc(getattr(value, f.name, None), inner)
+                if self.room < 0:
+                    raise _Over
         self.open.discard(id(value))
         self.made[key] = (value, out, before - self.room)  # the value held: its id is not reused meanwhile
         return out
@@ -148,9 +161,15 @@ def _key(key: Any) -> str:
 
 def encode(value: Any, cap: int | None = DEFAULT_CAP) -> Any:
     """A JSON-safe form of ``value``; larger than ``cap`` bytes once serialised -> a marker."""
+    t = type(value)
+    if (value is None or t is bool or (t is int and -(2 ** 63) <= value < 2 ** 64)
+            or (t is float and math.isfinite(value)) or (t is str and (cap is None or len(value) <= cap))):
+        return value
     walk = _Walk(MAX_UNCAPPED if cap is None else cap)
     try:
         out = walk.enc(value, 0)
+        if walk.room < 0:
+            raise _Over
     except _Over:
         size = (MAX_UNCAPPED if cap is None else cap) - walk.room
         return {"$truncated": True, "size": size, "repr": _short_repr(value)}

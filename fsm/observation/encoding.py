@@ -4,9 +4,9 @@ Encoding is bounded by what it makes, not by what it is given: a value that is s
 can be huge when expanded (a list of ten references to a list of ten references to ..., 368
 bytes as a pickle, 10^14 items as JSON; a cycle; an int of a million digits). The encoder
 walks each container once per depth (a shared one met again reuses its encoding, a cycle is
-cut with a marker), counts a lower bound of the bytes it has made, and stops at the cap; the
-short repr of a marker is made piece by piece up to its length. Encoding never raises: what
-cannot be encoded becomes a marker, so observing a machine never changes what it does.
+cut with a marker), counts a lower bound of the bytes it has made, and stops at the cap; a
+marker's text is made piece by piece up to its length (short_repr.py). Encoding never raises:
+what cannot be encoded becomes a marker, so observing a machine never changes what it does.
 """
 
 import dataclasses
@@ -14,6 +14,8 @@ import enum
 import json
 import math
 from typing import Any
+
+from .short_repr import CONTAINERS, cycle, int_text, short_repr
 
 try:
     import orjson
@@ -23,22 +25,14 @@ except ImportError:  # the runtime must work with the standard library alone
 DEFAULT_CAP = 8192
 MAX_UNCAPPED = 16 << 20  # bytes an encoding without a cap may still take
 _MAX_DEPTH = 16
-_REPR_LEN = 200
-_MAX_INT_BITS = 14_000  # at most 4,215 decimal digits: under Python's limit on int to str (4,300)
-_CONTAINERS = (list, tuple, set, frozenset, dict)
 
 
 class _Over(Exception):
     """The encoding has grown past its budget."""
 
 
-def _int_text(value: int) -> str | None:
-    """``str(value)`` of an int, or None when it has too many digits to be written."""
-    return None if value.bit_length() > _MAX_INT_BITS else str(value)
-
-
 def _marker(value: Any) -> dict:
-    return {"$repr": _short_repr(value)}
+    return {"$repr": short_repr(value)}
 
 
 class _Walk:
@@ -70,7 +64,7 @@ class _Walk:
             if -(2 ** 63) <= value < 2 ** 64:
                 self.room -= 1
                 return value
-            text = _int_text(value)
+            text = int_text(value)
             if text is None:
                 return self.opaque({"$repr": "<int of %d bits>" % value.bit_length()})
             self.room -= len(text) + 2
@@ -88,7 +82,7 @@ class _Walk:
             return self.container(value, depth)
         if isinstance(value, enum.Enum):
             return self.enc("%s.%s" % (type(value).__name__, value.name), depth)
-        if isinstance(value, _CONTAINERS) or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
+        if isinstance(value, CONTAINERS) or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
             return self.container(value, depth)
         if isinstance(value, (str, int, float)):  # subclasses such as bool-likes or IntEnum handled above
             return self.enc(type(value).__mro__[-2](value), depth)
@@ -112,10 +106,10 @@ class _Walk:
             self.take(done[2])
             return done[1]
         if id(value) in self.open:
-            return self.opaque({"$repr": _cycle(value)})
+            return self.opaque({"$repr": cycle(value)})
         self.open.add(id(value))
         before = self.room
-        fields = None if isinstance(value, _CONTAINERS) else dataclasses.fields(value)
+        fields = None if isinstance(value, CONTAINERS) else dataclasses.fields(value)
         self.take(1 + max(len(value if fields is None else fields), 1))  # brackets and commas
         enc = self.enc
         inner = depth + 1
@@ -127,7 +121,7 @@ class _Walk:
                 out[k] = enc(v, inner)
                 if self.room < 0:
                     raise _Over
-        elif isinstance(value, _CONTAINERS):
+        elif isinstance(value, CONTAINERS):
             out = []
             for v in value:
                 out.append(enc(v, inner))
@@ -150,9 +144,9 @@ def _key(key: Any) -> str:
     if type(key) is str:
         return key
     if type(key) is int:
-        return _int_text(key) or "<int of %d bits>" % key.bit_length()
+        return int_text(key) or "<int of %d bits>" % key.bit_length()
     if isinstance(key, (tuple, frozenset)):
-        return _short_repr(key)
+        return short_repr(key)
     try:
         return str(key)
     except Exception as exc:  # a user's __str__ may raise
@@ -172,118 +166,18 @@ def encode(value: Any, cap: int | None = DEFAULT_CAP) -> Any:
             raise _Over
     except _Over:
         size = (MAX_UNCAPPED if cap is None else cap) - walk.room
-        return {"$truncated": True, "size": size, "repr": _short_repr(value)}
+        return {"$truncated": True, "size": size, "repr": short_repr(value)}
     except Exception as exc:  # a user's value may raise anywhere (a property, __eq__, tolist)
         return {"$repr": "<unencodable %s: %s>" % (type(value).__name__, type(exc).__name__)}
     if cap is not None and isinstance(out, (list, dict, str)):  # counted low: the real size decides
         size = len(out) if isinstance(out, str) else len(dumps(out))
         if size > cap:
-            return {"$truncated": True, "size": size, "repr": _short_repr(value)}
+            return {"$truncated": True, "size": size, "repr": short_repr(value)}
     return out
 
 
 def encode_userdata(data: dict, cap: int | None = DEFAULT_CAP) -> dict:
     return {_key(k): encode(v, cap) for k, v in data.items()}
-
-
-class _Full(Exception):
-    """The short repr has its length."""
-
-
-def _short_repr(value: Any) -> str:
-    """``repr(value)`` cut after ``_REPR_LEN`` characters, made piece by piece: the plain containers
-    and dataclasses are written here, so that one which is big only when expanded costs no more
-    than the cut (a user's own ``__repr__`` is called as it is)."""
-    pieces: list[str] = []
-    left = [_REPR_LEN + 1]
-
-    def put(text: str) -> None:
-        pieces.append(text[:left[0]])
-        left[0] -= len(text)
-        if left[0] <= 0:
-            raise _Full
-
-    def write(v: Any, inside: set[int]) -> None:
-        t = type(v)
-        if t is str or t is bytes:
-            put(repr(v[:left[0]]) if len(v) > left[0] else repr(v))
-            return
-        if t is int:
-            put(_int_text(v) or "<int of %d bits>" % v.bit_length())
-            return
-        if not isinstance(v, _CONTAINERS) and not _plain_dataclass(v):
-            try:
-                put(repr(v))
-            except _Full:
-                raise
-            except Exception as exc:  # a user's __repr__ may raise
-                put("<unrepresentable %s: %s>" % (type(v).__name__, type(exc).__name__))
-            return
-        if id(v) in inside:
-            put(_cycle(v))
-            return
-        inside = inside | {id(v)}
-        if isinstance(v, dict):
-            items = list(_first(v.items()))
-            opening, closing = "{", "}"
-        elif isinstance(v, _CONTAINERS):
-            items = [(None, x) for x in _first(v)]
-            opening, closing = _brackets(v)
-        else:
-            items = [(f.name, getattr(v, f.name, None)) for f in dataclasses.fields(v) if f.repr]
-            opening, closing = type(v).__qualname__ + "(", ")"
-        put(opening)
-        for i, (k, x) in enumerate(items):
-            if i:
-                put(", ")
-            if isinstance(v, dict):
-                write(k, inside)
-                put(": ")
-            elif k is not None:
-                put(k + "=")
-            write(x, inside)
-        put(closing)
-
-    try:
-        write(value, set())
-    except _Full:
-        return "".join(pieces)[:_REPR_LEN] + "..."
-    return "".join(pieces)
-
-
-def _first(items: Any) -> Any:
-    """The first items of a container, as many as a short repr can show."""
-    for i, item in enumerate(items):
-        if i > _REPR_LEN // 2:
-            return
-        yield item
-
-
-def _brackets(value: Any) -> tuple[str, str]:
-    """How repr opens and closes a list, tuple, set or frozenset."""
-    if isinstance(value, list):
-        return "[", "]"
-    if isinstance(value, tuple):
-        return "(", ",)" if len(value) == 1 else ")"
-    name = "set" if isinstance(value, set) else "frozenset"
-    if not value:
-        return name + "(", ")"
-    return ("{", "}") if name == "set" else ("frozenset({", "})")
-
-
-def _plain_dataclass(value: Any) -> bool:
-    """A dataclass instance whose repr is the generated one (which ``_short_repr`` writes itself)."""
-    return (dataclasses.is_dataclass(value) and not isinstance(value, type)
-            and hasattr(type(value).__repr__, "__wrapped__"))
-
-
-def _cycle(value: Any) -> str:
-    """What repr writes for a container met again inside itself."""
-    if isinstance(value, list):
-        return "[...]"
-    if isinstance(value, dict):
-        return "{...}"
-    return "%s(...)" % type(value).__name__
 
 
 if orjson is not None:

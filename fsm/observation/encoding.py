@@ -87,8 +87,9 @@ class _Walk:
         if isinstance(value, (str, int, float)):  # subclasses such as bool-likes or IntEnum handled above
             return self.enc(type(value).__mro__[-2](value), depth)
         if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
-            if getattr(value, "size", 1) > self.room:  # each item takes a byte at least: too big before it is listed
-                raise _Over
+            items = getattr(value, "size", 1)
+            if items > self.room:  # each item takes a byte at least: too big before it is listed
+                self.take(items)
             return self.enc(value.tolist(), depth)
         inner = getattr(value, "_obj", None)  # fsm.core.user_data.Const
         if inner is not None and type(value).__name__ == "Const":

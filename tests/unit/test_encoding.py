@@ -126,6 +126,13 @@ def test_a_value_cut_for_its_depth_is_shown_by_a_short_repr_made_in_no_time():
     assert time.monotonic() - started < 0.5 and len(text) < 1000
 
 
+def test_a_numpy_array_too_big_for_the_cap_is_a_marker_before_it_is_listed():
+    started = time.monotonic()
+    encoded = encode(np.zeros(10_000_000))
+    assert time.monotonic() - started < 0.5
+    assert encoded["$truncated"] is True and encoded["size"] >= 10_000_000
+
+
 def test_a_shared_value_is_written_at_each_of_its_places():
     pose = [1.0, 2.0]
     assert encode({"a": pose, "b": [pose, pose]}) == {"a": [1.0, 2.0], "b": [[1.0, 2.0], [1.0, 2.0]]}

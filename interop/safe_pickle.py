@@ -11,7 +11,7 @@ they would with their arguments checked.
 What it builds costs no more than its bytes say: the unpickler is pickle's own in Python
 (``pickle._Unpickler``, the standard library's fallback, about 2.5 times slower than the C one),
 so that the steps which hash a value (a dict's key, a set's item) count what hashing reads
-against one budget per pickle first: a key of shared references (a tuple of ten references to a
+against one budget per pickle first (``HASHED_PER_BYTE`` steps per byte): a key of shared references (a tuple of ten references to a
 tuple of ten references to ..., a few hundred bytes that hashing reads 10^40 times) or one
 nested deep enough to overflow the C stack is refused, as is the pickle. A pickle names at most
 ``MAX_NAMES`` globals with a marker class of their own.
@@ -28,11 +28,15 @@ import pickle
 from typing import Any, Callable
 
 MAX_BYTES = 16 << 20  # a userdata pickle bigger than this is not read
-MAX_HASHED = 1 << 22  # parts that hashing the dict keys and set items of one pickle may read, in all
+# Steps that hashing the dict keys and set items of one pickle may take, in all: so many per byte of
+# the pickle (each part of a key that is not shared takes a byte of it at least), a million at least.
+HASHED_PER_BYTE = 4
+MIN_HASHED = 1 << 20
 MAX_KEY_DEPTH = 64  # nesting of a dict key or set item (hashing it recurses on the C stack)
 MAX_NAMES = 256  # globals of one pickle with a marker class of their own; the next ones share one
 
 
+_KEPT_PARTS = 16  # a key of so many parts is counted once and remembered (a shared one is met again)
 _TOO_DEEP = "a pickle with a dict key or set item nested deeper than %d levels" % MAX_KEY_DEPTH
 
 
@@ -119,7 +123,8 @@ class _Unpickler(pickle._Unpickler):
     def __init__(self, data: bytes) -> None:
         super().__init__(io.BytesIO(data), encoding="latin1")  # latin1: Python 2's str pickles
         self.hashed = 0
-        self.parts: dict[int, tuple[Any, int, int]] = {}  # id -> (the key, its parts, its nesting)
+        self.budget = max(MIN_HASHED, HASHED_PER_BYTE * len(data))
+        self.parts: dict[int, tuple[Any, int, int]] = {}  # id -> (a big key, its parts, its nesting)
         self.markers: dict[str, type[Opaque]] = {}
 
     def find_class(self, module: str, name: str) -> Any:
@@ -141,9 +146,9 @@ class _Unpickler(pickle._Unpickler):
     def hashing(self, key: Any) -> None:
         """``key`` is about to be hashed: what hashing reads is counted; TooCostly when over the budget."""
         self.hashed += self._parts(key, 0)[0]
-        if self.hashed > MAX_HASHED:
+        if self.hashed > self.budget:
             raise TooCostly("a pickle whose dict keys and set items would take hashing more than %d steps"
-                            % MAX_HASHED)
+                            % self.budget)
 
     def _parts(self, key: Any, depth: int) -> tuple[int, int]:
         """(what hashing ``key`` reads, its nesting): a tuple or frozenset each time it is hashed
@@ -158,8 +163,10 @@ class _Unpickler(pickle._Unpickler):
             parts, nesting = 1, 0
             for item in key:
                 inner = self._parts(item, depth + 1)
-                parts, nesting = min(parts + inner[0], MAX_HASHED + 1), max(nesting, inner[1] + 1)
-            known = self.parts[id(key)] = (key, parts, nesting)  # the key held: its id is not reused meanwhile
+                parts, nesting = min(parts + inner[0], self.budget + 1), max(nesting, inner[1] + 1)
+            known = (key, parts, nesting)
+            if parts >= _KEPT_PARTS:
+                self.parts[id(key)] = known  # the key held: its id is not reused meanwhile
         if depth + known[2] > MAX_KEY_DEPTH:
             raise TooCostly(_TOO_DEEP)
         return known[1], known[2]

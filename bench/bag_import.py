@@ -4,7 +4,12 @@ protocol 2 pickle), read with rosbags and turned into fsmscope events (interop/)
 against the rate at which fsmscope's JSONL reader reads the same events back from the log
 ``fsmscope import`` writes (the reference ratio the issue asks for). Medians of 3 runs.
 
-    .venv/bin/python bench/bag_import.py [--messages 100000]
+Then (issue 32) the import's time against the number of children of one container (a chain of
+states S0 -> S1 -> ..., its structure and three statuses): it was the square of that number (2,500
+children 2.3 s, 10,000 27 s, 20,000 over 120 s); the target is linear, each row within twice the
+time per child of the smallest, and 20,000 children in under 5 s.
+
+    .venv/bin/python bench/bag_import.py [--messages 100000] [--children 2500,5000,10000,20000,40000]
 """
 
 import argparse
@@ -20,7 +25,7 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 from fsm.logfiles.log_reader import read_events  # noqa: E402
 from interop.bag_reader import read_bag  # noqa: E402
 from interop.smach_events import events  # noqa: E402
-from interop.testing import write_bag  # noqa: E402
+from interop.testing import wide_run, write_bag  # noqa: E402
 from interop.to_log import write_log  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
@@ -46,9 +51,32 @@ def timed(work) -> tuple[float, int]:
     return time.perf_counter() - start, count
 
 
+def children_table(folder: Path, sizes: list[int]) -> None:
+    """Seconds to import a bag of one container with each number of children (medians of REPEATS)."""
+    seconds = {}
+    for n in sizes:
+        bag = write_bag(folder / ("wide-%d.bag" % n), "ros1", wide_run(n))
+        runs = []
+        for i in range(REPEATS):
+            log = str(folder / ("wide-%d-%d.jsonl" % (n, i)))
+            runs.append(timed(lambda: write_log(events(read_bag(str(bag))), log))[0])
+        seconds[n] = statistics.median(runs)
+    smallest = sizes[0]
+    per_child = seconds[smallest] / smallest
+    rows = []
+    for n in sizes:
+        limit = 2 * per_child * n
+        if n == 20_000:
+            limit = min(limit, 5.0)
+        rows.append(("%d children" % n, "< %.2f s" % limit, "%.2f s" % seconds[n], verdict(seconds[n] < limit)))
+    print_table("ROS bag import against a container's children (fsmscope import), medians of %d runs" % REPEATS, rows)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--messages", type=int, default=100_000)
+    parser.add_argument("--children", default="2500,5000,10000,20000,40000",
+                        help="the numbers of children of the container, smallest first")
     args = parser.parse_args()
     folder = Path(tempfile.mkdtemp(prefix="fsmscope-bag-bench-"))
     bag = write_bag(folder / "loop.bag", "ros1", loop_run(args.messages))
@@ -68,6 +96,8 @@ def main() -> None:
         ("fsmscope's JSONL reader, the same events (reference)", "", "%.0f events/s" % jsonl, verdict(None)),
         ("import's rate / the JSONL reader's", "", "%.2f" % (imp / jsonl), verdict(None)),
     ])
+    print()
+    children_table(folder, [int(n) for n in args.children.split(",")])
 
 
 if __name__ == "__main__":

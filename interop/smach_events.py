@@ -46,11 +46,13 @@ def _label(path: str) -> str:
 
 
 class _Tree:
-    """The containers of one server, from its structure messages and what its statuses named."""
+    """The containers of one server, from its structure messages and what its statuses named; each
+    container's edges, outcomes and edges by the state they leave made once, so that describing the
+    tree and following a run take time in proportion to them."""
 
     def __init__(self, messages: list[Message]) -> None:
         self.structures: dict[str, dict] = {}
-        self.named: dict[str, list[str]] = {}  # container -> states its statuses named
+        self.named: dict[str, dict[str, None]] = {}  # container -> states its statuses named, in order
         self.initial: dict[str, list[str]] = {}
         self.concurrent: set[str] = set()
         for m in messages:
@@ -59,52 +61,74 @@ class _Tree:
                 self.structures.setdefault(f["path"], f)
                 continue
             self.initial.setdefault(f["path"], [s for s in f["initial_states"] if s != NONE])
-            states = self.named.setdefault(f["path"], [])
+            states = self.named.setdefault(f["path"], {})
             for s in [*f["initial_states"], *f["active_states"]]:
-                if s != NONE and s not in states:
-                    states.append(s)
+                if s != NONE:
+                    states[s] = None
             if len(f["active_states"]) > 1 or len(f["initial_states"]) > 1:  # a Concurrence starts them all
                 self.concurrent.add(f["path"])
         self.paths = set(self.structures) | set(self.named)
         roots = sorted((p for p in self.paths if _parent(p) not in self.paths), key=len)
         self.root = roots[0] if roots else None
+        self._edges: dict[str, list[dict]] = {}
+        self._leaving: dict[str, dict[str, list[dict]]] = {}
+        self._outcomes: dict[str, list[str]] = {}
 
     def edges(self, path: str) -> list[dict]:
-        s = self.structures.get(path)
-        if s is None:
-            return []
-        return [schema.edge(f, o, None if t == NONE else t)
+        made = self._edges.get(path)
+        if made is None:
+            s = self.structures.get(path)
+            made = self._edges[path] = [] if s is None else [
+                schema.edge(f, o, None if t == NONE else t)
                 for o, f, t in zip(s["internal_outcomes"], s["outcomes_from"], s["outcomes_to"])]
+        return made
+
+    def leaving(self, path: str, state: str) -> list[dict]:
+        """The edges of the container at ``path`` from its child ``state``."""
+        by_state = self._leaving.get(path)
+        if by_state is None:
+            by_state = self._leaving[path] = {}
+            for e in self.edges(path):
+                by_state.setdefault(e["from"], []).append(e)
+        return by_state.get(state, [])
 
     def outcomes(self, path: str) -> list[str]:
-        s = self.structures.get(path)
-        return sorted(s["container_outcomes"]) if s else []
+        made = self._outcomes.get(path)
+        if made is None:
+            s = self.structures.get(path)
+            made = self._outcomes[path] = sorted(s["container_outcomes"]) if s else []
+        return made
 
     def children(self, path: str) -> list[str]:
         s = self.structures.get(path)
-        return list(s["children"]) if s else list(self.named.get(path, []))
+        return list(s["children"]) if s else list(self.named.get(path, {}))
 
-    def node(self, path: str) -> dict:
+    def node(self, path: str, depth: int = 0) -> dict:
+        """The structure node of ``path``; nothing below the schema's deepest level is described (the
+        schema then refuses the tree, with its words, and the recursion stays short)."""
         if path not in self.paths:
-            outcomes = sorted({e["outcome"] for e in self.edges(_parent(path)) if e["from"] == _label(path)})
+            outcomes = sorted({e["outcome"] for e in self.leaving(_parent(path), _label(path))})
             return schema.node(_label(path), path, "State", False, outcomes, [], [], {})
         node = schema.node(_label(path), path, "Concurrence" if path in self.concurrent else "StateMachine", True,
                            self.outcomes(path), [], [], {})
+        children = [] if depth > schema.MAX_STRUCTURE_DEPTH else self.children(path)
         node.update(schema.container_fields(self.initial.get(path, []), self.edges(path),
-                                            [self.node(path + "/" + c) for c in self.children(path)]))
+                                            [self.node(path + "/" + c, depth + 1) for c in children]))
         return node
 
     def outcome(self, path: str, last: list[str], returned: list[str]) -> tuple[str, str | None]:
         """(the container's outcome, its last state's) from the edges of its last states into its
         outcomes (those of the outcomes they ``returned``, when known), when they name one; else UNKNOWN."""
-        ends = {(e["to"], e["outcome"]) for e in self.edges(path) if e["from"] in last
-                and e["to"] in self.outcomes(path) and (not returned or e["outcome"] in returned)}
+        outcomes = self.outcomes(path)
+        ends = {(e["to"], e["outcome"]) for state in dict.fromkeys(last) for e in self.leaving(path, state)
+                if e["to"] in outcomes and (not returned or e["outcome"] in returned)}
         return next(iter(ends)) if len(ends) == 1 else (UNKNOWN, None)
 
     def step(self, path: str, source: str, target: str | None) -> str:
         """The outcome of the one edge from ``source`` to ``target`` (None: into an outcome), else UNKNOWN."""
-        found = {e["outcome"] for e in self.edges(path) if e["from"] == source
-                 and (e["to"] == target or (target is None and e["to"] in self.outcomes(path)))}
+        outcomes = self.outcomes(path)
+        found = {e["outcome"] for e in self.leaving(path, source)
+                 if e["to"] == target or (target is None and e["to"] in outcomes)}
         return found.pop() if len(found) == 1 else UNKNOWN
 
 
@@ -176,12 +200,15 @@ class _Machine:
         if now == before:
             return
         if path in self.tree.concurrent or len(before) > 1 or len(now) > 1:
-            left = [s for s in before if s not in now]
+            staying = set(now)
+            left = [s for s in before if s not in staying]
             if left:
                 self.left[path] = left
-            for i, state in enumerate(left):
+            gone: set[str] = set()
+            for state in left:
                 yield from self._leave(path, state, None)
-                remaining = [s for s in before if s not in left[:i + 1]]
+                gone.add(state)
+                remaining = [s for s in before if s not in gone]
                 self.active[path] = remaining
                 yield self._event(build.transition, path, state, self.tree.step(path, state, None), None, remaining)
             self.active[path] = list(now)
@@ -222,10 +249,12 @@ class _Machine:
             yield self._event(build.userdata, path, changed)
 
 
-def events(messages: Iterable[Message]) -> Iterator[dict]:
+def events(messages: Iterable[Message], refused: Callable[[str], None] | None = None) -> Iterator[dict]:
     """fsmscope's events of every introspection server in ``messages`` (time order), one machine per
     server named after it (a ROS name made a machine's name: ``robot/arm`` becomes ``robot_arm``,
-    fsm/observation/names.py); each machine's events in order, the machines' interleaved by time."""
+    fsm/observation/names.py); each machine's events in order, the machines' interleaved by time. A
+    machine whose structure the schema refuses (too deep, a path too long, ...) has no events:
+    ``refused`` hears why."""
     by_server: dict[str, list[Message]] = {}
     for m in messages:
         by_server.setdefault(m.server, []).append(m)
@@ -236,14 +265,20 @@ def events(messages: Iterable[Message]) -> Iterator[dict]:
         if tree.root is None:
             continue
         machine = _Machine(names.unique(server, taken), tree)
+        machine.t = msgs[0].t
+        structure = machine.structure()
+        problem = schema.validate(structure)
+        if problem is not None:
+            if refused is not None:
+                refused("machine %s, whose structure does not fit the schema: %s" % (machine.name, problem))
+            continue
         taken.add(machine.name)
-        streams.append(_machine_events(machine, msgs))
+        streams.append(_machine_events(machine, structure, msgs))
     yield from _merge(streams)
 
 
-def _machine_events(machine: _Machine, msgs: list[Message]) -> Iterator[dict]:
-    machine.t = msgs[0].t
-    yield machine.structure()
+def _machine_events(machine: _Machine, structure: dict, msgs: list[Message]) -> Iterator[dict]:
+    yield structure
     for m in msgs:
         if m.kind == "status":
             yield from machine.status(m)

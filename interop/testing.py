@@ -21,7 +21,7 @@ def _message(store, kind: str, fields: dict, t: float, ros2: bool, raw_pickle: b
     if kind == "structure":
         return store.types[smach_msgs.STRUCTURE](header=header, **fields)
     data = {k: v for k, v in fields.items() if k != "userdata"}
-    pickled = pickle.dumps(fields["userdata"], 2)
+    pickled = fields["userdata"] if isinstance(fields["userdata"], bytes) else pickle.dumps(fields["userdata"], 2)
     if ros2 or raw_pickle:
         data["local_data"] = numpy.frombuffer(pickled, dtype=numpy.uint8)
     else:
@@ -31,7 +31,7 @@ def _message(store, kind: str, fields: dict, t: float, ros2: bool, raw_pickle: b
 
 def write_bag(path: Path, layout: str, runs: list[tuple[float, str, str, dict]]) -> Path:
     """``runs``, (t, topic, kind "structure" or "status", fields; a status's ``userdata`` is pickled as
-    smach_ros does), written to a bag at ``path``: ``layout`` "ros1" (noetic: base64 of the pickle),
+    smach_ros does, or is the pickle when bytes), written to a bag at ``path``: ``layout`` "ros1" (noetic: base64 of the pickle),
     "ros1-raw" (the raw pickle of older releases), "ros2-sqlite3" or "ros2-mcap"."""
     ros2 = layout.startswith("ros2")
     raw = layout == "ros1-raw"
@@ -56,3 +56,28 @@ def write_bag(path: Path, layout: str, runs: list[tuple[float, str, str, dict]])
             data = store.serialize_cdr(msg, types[kind]) if ros2 else store.serialize_ros1(msg, types[kind])
             writer.write(connections[topic], int(t * 1e9), data)
     return path
+
+
+def container_run(server: str, structures: dict[str, tuple[list, list, list]],
+                  statuses: list[tuple[float, str, list, list, dict]], t0: float = 1.7e9) -> list:
+    """The messages (t, topic, kind, fields) of a server: each container's structure at ``t0``
+    (``structures``: path -> (children, edges (outcome, from, to), outcomes)), then ``statuses``
+    (seconds after ``t0``, path, initial states, active states, userdata)."""
+    run = [(t0, "/%s/smach/container_structure" % server, "structure", {
+        "path": path, "children": children, "internal_outcomes": [e[0] for e in edges],
+        "outcomes_from": [e[1] for e in edges], "outcomes_to": [e[2] for e in edges], "container_outcomes": outcomes})
+        for path, (children, edges, outcomes) in structures.items()]
+    run += [(t0 + t, "/%s/smach/container_status" % server, "status", {
+        "path": path, "initial_states": initial, "active_states": active, "userdata": userdata, "info": "HEARTBEAT"})
+        for t, path, initial, active, userdata in statuses]
+    return run
+
+
+def wide_run(children: int) -> list:
+    """A machine of one container with ``children`` states in a chain (S0 -> S1 -> ... -> done), run
+    from S0 to S1, then ended."""
+    labels = ["S%d" % i for i in range(children)]
+    edges = [("next", label, labels[i + 1] if i + 1 < children else "done") for i, label in enumerate(labels)]
+    return container_run("wide", {"/ROOT": (labels, edges, ["done"])},
+                         [(0.0, "/ROOT", ["S0"], ["S0"], {}), (1.0, "/ROOT", ["S0"], ["S1"], {}),
+                          (2.0, "/ROOT", ["S0"], ["None"], {})])

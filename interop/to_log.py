@@ -5,9 +5,10 @@ travel and export work on them unchanged."""
 from __future__ import annotations
 
 import os
-from typing import Iterable
+from typing import Callable, Iterable
 
 from fsm.logfiles.recorder import Recorder, index_path
+from fsm.observation.schema import validate
 
 
 class ReadError(Exception):
@@ -22,24 +23,39 @@ class Damaged(ReadError):
         self.written = written
 
 
-def write_log(events: Iterable[dict], log: str) -> int:
-    """``events`` into a new file ``log``; the number written. Raises ``ReadError`` (from the source)
-    when nothing can be read (no file is left), ``Damaged`` when part can."""
+class NoEvents(ReadError):
+    """Not one event of the source fits the schema (or it has none): no log is written."""
+
+
+def write_log(events: Iterable[dict], log: str, skipped: Callable[[str], None] | None = None) -> int:
+    """``events`` into a new file ``log``; the number written. Each event is checked by the schema's
+    validator first, as replay checks each line (fsm.observation.schema.validate): one it refuses is
+    not written (``skipped`` hears why), so that a log imported is one replay reads whole. Raises
+    ``ReadError`` (from the source) when nothing can be read, ``NoEvents`` when no event fits (no file
+    is left then), ``Damaged`` when part can be read."""
     if os.path.exists(log):
         raise ReadError("%s exists already: a new log is written" % log)
-    written = 0
+    written = refused = 0
     damage = None
     partial = log + ".partial"
     try:
         with Recorder(partial) as recorder:
             try:
                 for event in events:
+                    problem = validate(event)
+                    if problem is not None:
+                        refused += 1
+                        if skipped is not None:
+                            skipped("an event that does not fit the schema: %s" % problem)
+                        continue
                     recorder(event)
                     written += 1
             except ReadError as exc:
                 if not written:
                     raise
                 damage = Damaged(str(exc), written)
+        if not written:
+            raise NoEvents("no events%s" % (" (%d refused)" % refused if refused else ""))
     except BaseException:
         for path in (partial, index_path(partial)):
             if os.path.exists(path):

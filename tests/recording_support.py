@@ -3,6 +3,7 @@
 import contextlib
 import os
 import re
+import resource
 import runpy
 import signal
 import subprocess
@@ -31,14 +32,18 @@ def record(sm, path, name: str = "m", **recorder_kwargs):
     return outcome, seen
 
 
-def cli(*args, cwd=None, env=None, timeout=60):
-    """``fsmscope ARGS`` in a real process; returns the CompletedProcess (text)."""
+def cli(*args, cwd=None, env=None, timeout=60, memory=None):
+    """``fsmscope ARGS`` in a real process; returns the CompletedProcess (text). ``memory``: a limit on
+    its address space in bytes, so that a process that would take the machine's memory fails fast."""
     full_env = dict(os.environ, **(env or {}))
     full_env["PYTHONPATH"] = ROOT + os.pathsep + full_env.get("PYTHONPATH", "")
     if args and args[0] == "run" and "--exit" not in args:  # `run` keeps serving the dashboard unless --exit
         args = ("run", "--exit") + tuple(args[1:])
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
     return subprocess.run([sys.executable, "-m", "server.cli", *map(str, args)], cwd=cwd or ROOT, env=full_env,
-                          capture_output=True, text=True, timeout=timeout)
+                          capture_output=True, text=True, timeout=timeout, preexec_fn=memory and limited)
 
 
 @contextlib.contextmanager

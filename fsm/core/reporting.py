@@ -17,7 +17,8 @@ import traceback
 from typing import Any, Callable, Protocol
 
 class Reporter(Protocol):
-    """What core calls on an observed state's ``_reporter`` (implemented by fsm.observation.introspection)."""
+    """What core calls on an observed state's ``_reporter`` (implemented by fsm.observation.introspection);
+    its calls never raise: observing a machine never changes what it does."""
 
     root: Any  # the top-level container it reports for
 

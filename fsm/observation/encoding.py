@@ -1,4 +1,13 @@
-"""JSON-safe encoding of user values and fast serialisation of events. Never pickle."""
+"""JSON-safe encoding of user values and fast serialisation of events. Never pickle.
+
+Encoding is bounded by what it makes, not by what it is given: a value that is small in memory
+can be huge when expanded (a list of ten references to a list of ten references to ..., 368
+bytes as a pickle, 10^14 items as JSON; a cycle; an int of a million digits). The encoder
+walks each container once per depth (a shared one met again reuses its encoding, a cycle is
+cut with a marker), counts a lower bound of the bytes it has made, and stops at the cap; a
+marker's text is made piece by piece up to its length (short_repr.py). Encoding never raises:
+what cannot be encoded becomes a marker, so observing a machine never changes what it does.
+"""
 
 import dataclasses
 import enum
@@ -6,67 +15,170 @@ import json
 import math
 from typing import Any
 
+from .short_repr import CONTAINERS, cycle, int_text, short_repr
+
 try:
     import orjson
 except ImportError:  # the runtime must work with the standard library alone
     orjson = None
 
 DEFAULT_CAP = 8192
+MAX_UNCAPPED = 16 << 20  # bytes an encoding without a cap may still take
 _MAX_DEPTH = 16
-_REPR_LEN = 200
 
 
-def _short_repr(value: Any) -> str:
-    try:
-        text = repr(value)
-    except Exception as exc:  # a user's __repr__ may raise
-        text = "<unrepresentable %s: %s>" % (type(value).__name__, type(exc).__name__)
-    return text if len(text) <= _REPR_LEN else text[:_REPR_LEN] + "..."
+class _Over(Exception):
+    """The encoding has grown past its budget."""
 
 
-def _enc(value: Any, depth: int) -> Any:
-    if value is None or value is True or value is False or type(value) is str:
-        return value
-    if type(value) is int:
-        return value if -(2 ** 63) <= value < 2 ** 64 else str(value)
-    if type(value) is float:
-        if math.isfinite(value):
+def _marker(value: Any) -> dict:
+    return {"$repr": short_repr(value)}
+
+
+class _Walk:
+    """One value's encoding: the bytes it may still take (counted low: a number as one character,
+    a string as its length), and what it has made of each container at each depth."""
+
+    __slots__ = ("room", "made", "open")
+
+    def __init__(self, budget: int) -> None:
+        self.room = budget
+        self.made: dict[tuple[int, int], tuple[Any, Any, int]] = {}  # (id, depth) -> (value, encoded, bytes)
+        self.open: set[int] = set()  # ids of the containers being encoded: met again inside, a cycle
+
+    def take(self, size: int) -> None:
+        self.room -= size
+        if self.room < 0:
+            raise _Over
+
+    def enc(self, value: Any, depth: int) -> Any:
+        """The encoding of ``value``; the bytes it takes are counted (a caller checks the room left)."""
+        t = type(value)
+        if t is str:
+            self.room -= len(value) + 2
             return value
-        return "NaN" if value != value else ("Infinity" if value > 0 else "-Infinity")
-    if depth >= _MAX_DEPTH:
-        return {"$repr": _short_repr(value)}
-    if isinstance(value, enum.Enum):
-        return "%s.%s" % (type(value).__name__, value.name)
-    if isinstance(value, (list, tuple, set, frozenset)):
-        return [_enc(v, depth + 1) for v in value]
-    if isinstance(value, dict):
-        return {k if type(k) is str else str(k): _enc(v, depth + 1) for k, v in value.items()}
-    if isinstance(value, (str, int, float)):  # subclasses such as bool-likes or IntEnum handled above
-        return _enc(type(value).__mro__[-2](value), depth)
-    if dataclasses.is_dataclass(value) and not isinstance(value, type):
-        return {f.name: _enc(getattr(value, f.name, None), depth + 1) for f in dataclasses.fields(value)}
-    module = type(value).__module__
-    if module == "numpy":
-        if hasattr(value, "tolist"):
-            return _enc(value.tolist(), depth)
-    inner = getattr(value, "_obj", None)  # fsm.core.user_data.Const
-    if inner is not None and type(value).__name__ == "Const":
-        return _enc(inner, depth)
-    return {"$repr": _short_repr(value)}
+        if value is None or value is True or value is False:
+            self.room -= 4
+            return value
+        if t is int:
+            if -(2 ** 63) <= value < 2 ** 64:
+                self.room -= 1
+                return value
+            text = int_text(value)
+            if text is None:
+                return self.opaque({"$repr": "<int of %d bits>" % value.bit_length()})
+            self.room -= len(text) + 2
+            return text
+        if t is float:
+            self.room -= 1
+            if math.isfinite(value):
+                return value
+            return "NaN" if value != value else ("Infinity" if value > 0 else "-Infinity")
+        if self.room < 0:
+            raise _Over
+        if depth >= _MAX_DEPTH:
+            return self.opaque(_marker(value))
+        if t is list or t is dict or t is tuple:
+            return self.container(value, depth)
+        if isinstance(value, enum.Enum):
+            return self.enc("%s.%s" % (type(value).__name__, value.name), depth)
+        if isinstance(value, CONTAINERS) or (dataclasses.is_dataclass(value) and not isinstance(value, type)):
+            return self.container(value, depth)
+        if isinstance(value, (str, int, float)):  # subclasses such as bool-likes or IntEnum handled above
+            return self.enc(type(value).__mro__[-2](value), depth)
+        if type(value).__module__ == "numpy" and hasattr(value, "tolist"):
+            items = getattr(value, "size", 1)
+            if items > self.room:  # each item takes a byte at least: too big before it is listed
+                self.take(items)
+            return self.enc(value.tolist(), depth)
+        inner = getattr(value, "_obj", None)  # fsm.core.user_data.Const
+        if inner is not None and type(value).__name__ == "Const":
+            return self.enc(inner, depth)
+        return self.opaque(_marker(value))
+
+    def opaque(self, marker: dict) -> dict:
+        self.room -= len(marker["$repr"]) + 12
+        return marker
+
+    def container(self, value: Any, depth: int) -> Any:
+        key = (id(value), depth)
+        done = self.made.get(key)
+        if done is not None:  # a shared reference: its encoding again, its bytes counted again
+            self.take(done[2])
+            return done[1]
+        if id(value) in self.open:
+            return self.opaque({"$repr": cycle(value)})
+        self.open.add(id(value))
+        before = self.room
+        fields = None if isinstance(value, CONTAINERS) else dataclasses.fields(value)
+        self.take(1 + max(len(value if fields is None else fields), 1))  # brackets and commas
+        enc = self.enc
+        inner = depth + 1
+        if isinstance(value, dict):
+            out: Any = {}
+            for k, v in value.items():
+                k = _key(k)
+                self.room -= len(k) + 3
+                out[k] = enc(v, inner)
+                if self.room < 0:
+                    raise _Over
+        elif isinstance(value, CONTAINERS):
+            out = []
+            for v in value:
+                out.append(enc(v, inner))
+                if self.room < 0:
+                    raise _Over
+        else:
+            out = {}
+            for f in fields:
+                self.room -= len(f.name) + 3
+                out[f.name] = enc(getattr(value, f.name, None), inner)
+                if self.room < 0:
+                    raise _Over
+        self.open.discard(id(value))
+        self.made[key] = (value, out, before - self.room)  # the value held: its id is not reused meanwhile
+        return out
+
+
+def _key(key: Any) -> str:
+    """A dict key as a string (JSON's keys are)."""
+    if type(key) is str:
+        return key
+    if type(key) is int:
+        return int_text(key) or "<int of %d bits>" % key.bit_length()
+    if isinstance(key, (tuple, frozenset)):
+        return short_repr(key)
+    try:
+        return str(key)
+    except Exception as exc:  # a user's __str__ may raise
+        return "<unrepresentable %s: %s>" % (type(key).__name__, type(exc).__name__)
 
 
 def encode(value: Any, cap: int | None = DEFAULT_CAP) -> Any:
     """A JSON-safe form of ``value``; larger than ``cap`` bytes once serialised -> a marker."""
-    out = _enc(value, 0)
-    if cap is not None and isinstance(out, (list, dict, str)):
+    t = type(value)
+    if (value is None or t is bool or (t is int and -(2 ** 63) <= value < 2 ** 64)
+            or (t is float and math.isfinite(value)) or (t is str and (cap is None or len(value) <= cap))):
+        return value
+    walk = _Walk(MAX_UNCAPPED if cap is None else cap)
+    try:
+        out = walk.enc(value, 0)
+        if walk.room < 0:
+            raise _Over
+    except _Over:
+        size = (MAX_UNCAPPED if cap is None else cap) - walk.room
+        return {"$truncated": True, "size": size, "repr": short_repr(value)}
+    except Exception as exc:  # a user's value may raise anywhere (a property, __eq__, tolist)
+        return {"$repr": "<unencodable %s: %s>" % (type(value).__name__, type(exc).__name__)}
+    if cap is not None and isinstance(out, (list, dict, str)):  # counted low: the real size decides
         size = len(out) if isinstance(out, str) else len(dumps(out))
         if size > cap:
-            return {"$truncated": True, "size": size, "repr": _short_repr(value)}
+            return {"$truncated": True, "size": size, "repr": short_repr(value)}
     return out
 
 
 def encode_userdata(data: dict, cap: int | None = DEFAULT_CAP) -> dict:
-    return {str(k): encode(v, cap) for k, v in data.items()}
+    return {_key(k): encode(v, cap) for k, v in data.items()}
 
 
 if orjson is not None:

@@ -34,6 +34,28 @@ _listening: set[Reporter] = set()
 _listening_lock = threading.Lock()
 
 
+def _never_raising(call: Callable[..., None]) -> Callable[..., None]:
+    """One of core's calls on the reporter, made unable to fail: observing never changes what a
+    machine does, so what goes wrong in it is said once (``Reporter._failed``) and goes no further."""
+    what = "observing (%s)" % call.__name__
+
+    @functools.wraps(call)
+    def observed(self: Reporter, *args: Any) -> None:
+        try:
+            call(self, *args)
+        except Exception:
+            self._failed(call, what)
+    return observed
+
+
+def _words(exc: BaseException) -> str:
+    """``str(exc)``, or what traceback writes when a user's exception cannot say it."""
+    try:
+        return str(exc)
+    except Exception:
+        return "<exception str() failed>"
+
+
 class Reporter:
     """Stamps one machine's events (seq, time, run) and hands them to its observers in order."""
 
@@ -95,7 +117,9 @@ class Reporter:
             lock.release()
         return event
 
-    # Core's calls (fsm.core.reporting.Reporter), one per kind.
+    # Core's calls (fsm.core.reporting.Reporter), one per kind; those that do more than send (encode a
+    # value, describe the tree, word an exception) are ``_never_raising``.
+    @_never_raising
     def start(self, path: str, initial: list[str], active: list[str], userdata: Any) -> None:
         self.send(_start, path, initial, active, encode_userdata(userdata._data))
 
@@ -106,30 +130,34 @@ class Reporter:
                   state_outcome: str | None = ABSENT, outcomes: dict = ABSENT, error: str | None = ABSENT) -> None:
         self.send(_terminate, path, last, outcome, active, state_outcome, outcomes, error)
 
+    @_never_raising
     def userdata(self, path: str, written: dict) -> None:
         self.send(_userdata, path, encode_userdata(written))
 
     def preempt(self, path: str, phase: str) -> None:
         self.send(_preempt, path, phase)
 
+    @_never_raising
     def error(self, path: str, state: Any, exc: BaseException) -> None:
         """Describe the root cause (the user's own exception), not SMACH's wrapper around it."""
         root = exc
         while root.__cause__ is not None:
             root = root.__cause__
-        self.send(_error, path, None if state is None else str(state), type(root).__name__, str(root),
+        self.send(_error, path, None if state is None else str(state), type(root).__name__, _words(root),
                    "".join(traceback.format_exception(type(exc), exc, exc.__traceback__)),
                    type(exc).__name__ if root is not exc else ABSENT)
 
-    def _failed(self, observer: Observer) -> None:
-        """An observer could not take an event: said once per observer (with why), not per event,
-        since one that fails once usually fails on every event that follows."""
+    def _failed(self, observer: Any, what: str = "an observer") -> None:
+        """An observer (or the reporter's own work for one of core's calls) could not take an event:
+        said once per observer (with why), not per event, since one that fails once usually fails on
+        every event that follows."""
         if any(o is observer for o in self._told):
             return
         self._told.append(observer)
-        sys.stderr.write("fsm: an observer of machine %r failed (its next failures are not printed):\n%s"
-                         % (self.machine, traceback.format_exc()))
+        sys.stderr.write("fsm: %s of machine %r failed (its next failures are not printed):\n%s"
+                         % (what, self.machine, traceback.format_exc()))
 
+    @_never_raising
     def begin_run(self) -> None:
         """Called by the root container as it starts: a new run id, then the structure if it
         changed since it was last sent (or an observer joined since)."""

@@ -11,7 +11,8 @@ from typing import Callable, Iterator
 HELP = "turn a ROS bag of SMACH runs (ROS 1 .bag, ROS 2 sqlite3 or mcap), or fsmscope's MCAP, into an fsmscope log"
 PASSES_ARGUMENTS_ON = False
 EXIT_DAMAGED = 1  # the bag is damaged part way: the events before the damage were written
-EXIT_UNREADABLE = 2  # the bag cannot be read, or holds no SMACH introspection
+EXIT_UNREADABLE = 2  # the bag cannot be read, or holds no SMACH introspection, or no event that fits the schema
+SHOWN = 300  # characters of a reason a skipped line shows
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -23,16 +24,20 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 def convert(source: str, log: str, command: str) -> int:
     """Write the events of ``source`` (a ROS bag, or an MCAP file fsmscope wrote) to ``log``, saying
     what happened on stderr as ``fsmscope COMMAND``; the exit code."""
-    from interop.to_log import Damaged, ReadError, write_log
+    from interop.to_log import Damaged, NoEvents, ReadError, write_log
 
     def skipped(problem: str) -> None:
-        print("fsmscope %s: %s: skipped %s" % (command, source, problem), file=sys.stderr, flush=True)
+        shown = problem if len(problem) <= SHOWN else problem[:SHOWN] + "…"  # its words may quote a huge path
+        print("fsmscope %s: %s: skipped %s" % (command, source, shown), file=sys.stderr, flush=True)
 
     try:
-        written = write_log(events_of(source, skipped), log)
+        written = write_log(events_of(source, skipped), log, skipped)
     except Damaged as exc:
         print("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written), file=sys.stderr)
         return EXIT_DAMAGED
+    except NoEvents as exc:
+        print("fsmscope %s: %s: %s" % (command, source, exc), file=sys.stderr)
+        return EXIT_UNREADABLE
     except ReadError as exc:
         print("fsmscope %s: %s" % (command, exc), file=sys.stderr)
         return EXIT_UNREADABLE
@@ -47,7 +52,7 @@ def events_of(source: str, skipped: Callable[[str], None]) -> Iterator[dict]:
     from interop.mcap_log import is_fsmscope_mcap, read_mcap
     from interop.smach_events import events
 
-    return read_mcap(source, skipped) if is_fsmscope_mcap(source) else events(read_bag(source))
+    return read_mcap(source, skipped) if is_fsmscope_mcap(source) else events(read_bag(source), skipped)
 
 
 def converts(source: str) -> bool:

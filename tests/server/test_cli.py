@@ -86,6 +86,22 @@ def test_run_returns_the_script_exit_code(tmp_path):
     assert cli("run", script, "--record", tmp_path / "r.jsonl").returncode == 3
 
 
+def test_run_of_a_machine_holding_an_int_too_long_for_text_ends_as_it_does_without_fsmscope(tmp_path):
+    script = tmp_path / "big.py"
+    script.write_text("import fsm as smach\n"
+                      "def put(ud):\n"
+                      "    ud.big = 10 ** 5000\n"
+                      "    return 'done'\n"
+                      "sm = smach.StateMachine(['done'])\n"
+                      "with sm:\n"
+                      "    smach.StateMachine.add('PUT', smach.CBState(put, outcomes=['done'], output_keys=['big']), {})\n"
+                      "print('outcome', sm.execute())\n")
+    log = tmp_path / "big.jsonl"
+    done = cli("run", "--no-serve", script, "--record", log)
+    assert done.returncode == 0 and "outcome done" in done.stdout and "Traceback" not in done.stderr, done.stderr
+    assert json.loads(cli("replay", log, "--json").stdout)["machines"]["big"]["outcome"] == "done"
+
+
 def test_replay_prints_the_transcript_then_the_summary_and_exits_0(foo_bar_log):
     done = cli("replay", foo_bar_log)
     assert done.returncode == 0

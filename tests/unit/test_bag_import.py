@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import pickle
+import time
 
 import pytest
 from bag_support import GRASP, PLACE, ROOT, messages, write_bag
@@ -14,6 +15,7 @@ from recording_support import cli
 from fsm.logfiles.log_reader import read_events
 from fsm.observation import schema
 from interop import bag_reader, smach_events
+from interop.testing import container_run, wide_run
 
 LAYOUTS = {"ros1": "run.bag", "ros1-raw": "run.bag", "ros2-sqlite3": "run", "ros2-mcap": "run"}
 
@@ -145,3 +147,94 @@ def test_a_humble_sqlite3_bag_without_message_definitions_reads_with_ours(tmp_pa
     with sqlite3.connect(next(bag.glob("*.db3"))) as db:  # Humble's rosbag2 stored no definitions
         db.execute("DELETE FROM message_definitions")
     assert events_of(bag) == noetic_events
+
+
+def with_userdata(userdata) -> list:
+    """The run, every status's userdata ``userdata`` (a value, or the pickle itself when bytes)."""
+    return [(t, topic, kind, dict(fields, userdata=userdata) if kind == "status" else fields)
+            for t, topic, kind, fields in messages()]
+
+
+def shared_levels(levels: int = 14, width: int = 10) -> list:
+    """A list of ``width`` references to a list of ... : 368 bytes as a pickle, ``width ** levels`` items written out."""
+    value: list = []
+    for _ in range(levels):
+        value = [value] * width
+    return value
+
+
+GIB = 1 << 30
+
+
+def test_import_and_replay_of_userdata_huge_only_when_written_out_take_little_memory_and_time(tmp_path):
+    bag = write_bag(tmp_path / "bomb.bag", "ros1", with_userdata({"bomb": shared_levels()}))
+    done = cli("import", bag, "-o", tmp_path / "bomb.jsonl", memory=GIB, timeout=60)
+    assert done.returncode == 0 and "Traceback" not in done.stderr, done.stderr[-2000:]
+    start = next(ev for ev in read_events(str(tmp_path / "bomb.jsonl")) if ev["kind"] == "start")
+    assert start["userdata"]["bomb"]["$truncated"] is True
+    replayed = cli("replay", bag, memory=GIB, timeout=60)
+    assert replayed.returncode == 0 and "Traceback" not in replayed.stderr, replayed.stderr[-2000:]
+
+
+def test_import_of_an_int_too_long_for_text_writes_a_marker(tmp_path):
+    bag = write_bag(tmp_path / "big.bag", "ros1", with_userdata({"big": 10 ** 5000}))
+    done = cli("import", bag, "-o", tmp_path / "big.jsonl")
+    assert done.returncode == 0, done.stderr[-2000:]
+    start = next(ev for ev in read_events(str(tmp_path / "big.jsonl")) if ev["kind"] == "start")
+    assert start["userdata"]["big"] == {"$repr": "<int of 16610 bits>"}
+
+
+def test_import_of_a_dict_key_nested_deeper_than_hashing_can_go_says_the_userdata_was_not_read(tmp_path):
+    key = b")" + b"\x85" * 1_000_000  # ((((...)))) a million deep, built opcode by opcode
+    run = messages()
+    first = next(i for i, (_, _, kind, _) in enumerate(run) if kind == "status")
+    run[first] = run[first][:3] + (dict(run[first][3], userdata=b"\x80\x02}" + key + b"K\x01s."),)
+    done = cli("import", write_bag(tmp_path / "deep.bag", "ros1", run), "-o", tmp_path / "deep.jsonl", memory=GIB,
+               timeout=60)
+    assert done.returncode == 0, done.stderr[-2000:]
+    said = [ev["msg"] for ev in read_events(str(tmp_path / "deep.jsonl")) if ev["kind"] == "log"]
+    assert said == ["userdata not read: a pickle with a dict key or set item nested deeper than 64 levels"]
+
+
+@pytest.mark.timeout(60)
+def test_a_container_of_twenty_thousand_states_is_read_in_seconds(tmp_path):
+    bag = write_bag(tmp_path / "wide.bag", "ros1", wide_run(20_000))
+    started = time.monotonic()
+    read = events_of(bag)
+    assert time.monotonic() - started < 10  # 2 s here; the time was the square of the states' number (> 120 s)
+    assert len(read[0]["root"]["children"]) == 20_000 and read[-1]["kind"] == "terminate"
+
+
+def nested_run(levels: int) -> list:
+    """A container in a container ... ``levels`` deep, each going from its one child to 'done'."""
+    paths = ["/ROOT" + "/C" * i for i in range(levels + 1)]
+    structures = {path: (["C"], [("ok", "C", "done")], ["done"]) for path in paths}
+    return container_run("nested", structures, [(0.0, paths[0], ["C"], ["C"], {}), (1.0, paths[0], ["C"], ["None"], {})])
+
+
+def test_import_of_containers_nested_deeper_than_the_schema_allows_says_why_and_writes_nothing(tmp_path):
+    bag = write_bag(tmp_path / "nested.bag", "ros1", nested_run(200))
+    done = cli("import", bag, "-o", tmp_path / "nested.jsonl")
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr[-2000:]
+    assert "skipped machine nested, whose structure does not fit the schema: structure.root the structure is " \
+           "deeper than %d levels" % schema.MAX_STRUCTURE_DEPTH in done.stderr
+    assert "nested.bag: no events" in done.stderr and not (tmp_path / "nested.jsonl").exists()
+
+
+def test_import_refuses_a_path_longer_than_the_schema_allows_as_replay_does_and_says_why(tmp_path):
+    path = "/" + "x" * schema.MAX_PATH
+    bag = write_bag(tmp_path / "long.bag", "ros1", container_run("long", {path: (["A"], [("ok", "A", "done")], ["done"])},
+                                                                 [(0.0, path, ["A"], ["A"], {})]))
+    why = "event.path must be a string of 1 to %d characters" % schema.MAX_PATH
+    for done in (cli("import", bag, "-o", tmp_path / "long.jsonl"), cli("replay", bag)):
+        assert done.returncode == 2 and why in done.stderr, done.stderr[-2000:]
+    assert not (tmp_path / "long.jsonl").exists()
+
+
+def test_an_event_the_schema_refuses_is_not_written_and_the_rest_are(tmp_path):
+    from interop.to_log import write_log
+
+    good = schema.build.log(1, 1.0, None, "m", "/ROOT", "info", "kept")
+    told = []
+    assert write_log([good, dict(good, seq=-1)], str(tmp_path / "some.jsonl"), told.append) == 1
+    assert told == ["an event that does not fit the schema: event.seq must be an integer from 0 to 2^53-1, not an integer"]

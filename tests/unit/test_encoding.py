@@ -4,6 +4,7 @@ import dataclasses
 import enum
 import json
 import math
+import time
 
 import fsm
 import numpy as np
@@ -97,6 +98,55 @@ def test_a_read_only_input_is_encoded_as_the_value_it_wraps():
 def test_userdata_keys_are_encoded_one_by_one_under_the_cap():
     encoded = encode_userdata({"small": 1, "big": "x" * (DEFAULT_CAP + 1)})
     assert encoded["small"] == 1 and encoded["big"]["$truncated"] is True
+
+
+def shared_levels(levels=14, width=10):
+    """A list of ``width`` references to a list of ``width`` references to ... : small in memory, ``width ** levels``
+    items when written out."""
+    value = []
+    for _ in range(levels):
+        value = [value] * width
+    return value
+
+
+def test_a_value_that_is_huge_only_when_expanded_is_cut_at_the_cap_in_no_time():
+    started = time.monotonic()
+    encoded = encode(shared_levels())
+    assert time.monotonic() - started < 0.5
+    assert encoded["$truncated"] is True and DEFAULT_CAP < encoded["size"] < 2 * DEFAULT_CAP
+    assert encoded["repr"].startswith("[[[[[[[[[[[[[[[], []") and len(encoded["repr"]) <= 203
+
+
+def test_a_value_cut_for_its_depth_is_shown_by_a_short_repr_made_in_no_time():
+    value = shared_levels()
+    for _ in range(20):
+        value = [value]
+    started = time.monotonic()
+    text = strict_json(encode(value, cap=None))
+    assert time.monotonic() - started < 0.5 and len(text) < 1000
+
+
+def test_a_numpy_array_too_big_for_the_cap_is_a_marker_before_it_is_listed():
+    started = time.monotonic()
+    encoded = encode(np.zeros(10_000_000))
+    assert time.monotonic() - started < 0.5
+    assert encoded["$truncated"] is True and encoded["size"] >= 10_000_000
+
+
+def test_a_shared_value_is_written_at_each_of_its_places():
+    pose = [1.0, 2.0]
+    assert encode({"a": pose, "b": [pose, pose]}) == {"a": [1.0, 2.0], "b": [[1.0, 2.0], [1.0, 2.0]]}
+
+
+def test_a_value_that_holds_itself_is_cut_where_it_comes_back():
+    loop = [1]
+    loop.append(loop)
+    assert encode(loop) == [1, {"$repr": "[...]"}]
+
+
+def test_an_int_with_more_digits_than_python_writes_is_a_marker():
+    assert encode(10 ** 5000) == {"$repr": "<int of 16610 bits>"}
+    assert encode({10 ** 5000: 1}) == {"<int of 16610 bits>": 1}
 
 
 json_like = st.recursive(

@@ -333,3 +333,53 @@ def test_an_observer_that_cannot_take_events_is_reported_once_and_the_others_get
 def test_a_machine_attached_under_a_name_no_key_or_address_can_hold_is_refused_at_once():
     with pytest.raises(ValueError, match=r"a machine's name must not hold '#'"):
         smach.attach(_nested(), name="task#2")
+
+
+def _writes_a_huge_int(ud):
+    ud.big = 10 ** 5000  # more digits than Python turns into text (4,300)
+    return "done"
+
+
+def test_a_value_that_cannot_be_written_as_text_is_a_marker_and_the_run_ends_as_unobserved(observe):
+    unobserved = machine(["done"], [("PUT", Out(_writes_a_huge_int, output_keys=["big"]), {"done": "done"})])
+    observed = machine(["done"], [("PUT", Out(_writes_a_huge_int, output_keys=["big"]), {"done": "done"})])
+    events = observe(observed)
+    assert observed.execute() == unobserved.execute() == "done"
+    written = next(e["changes"] for e in events if e["kind"] == "userdata")
+    assert written == {"big": {"$repr": "<int of 16610 bits>"}}
+
+
+class Wordless(Exception):
+    def __str__(self):
+        raise RuntimeError("no words")
+
+
+def _raises_wordless(ud):
+    raise Wordless()
+
+
+def test_an_exception_that_cannot_say_what_it_is_ends_the_run_as_it_does_unobserved(observe):
+    def run(observed):
+        sm = machine(["done"], [("BAD", Out(_raises_wordless), {"done": "done"})])
+        events = observe(sm) if observed else []
+        with pytest.raises(smach.InvalidUserCodeError) as raised:
+            sm.execute()
+        return type(raised.value.__cause__), events
+    assert run(observed=True)[0] is run(observed=False)[0] is Wordless
+    error = next(e for e in run(observed=True)[1] if e["kind"] == "error")
+    assert error["exc_type"] == "Wordless" and error["message"] == "<exception str() failed>"
+
+
+def test_a_value_that_raises_when_looked_at_is_a_marker_and_the_run_ends_as_unobserved(observe):
+    class Haunted:
+        def __getattr__(self, name):
+            raise RuntimeError("no attribute may be read")
+
+    def writes(ud):
+        ud.ghost = Haunted()
+        return "done"
+    sm = machine(["done"], [("A", Out(writes, output_keys=["ghost"]), {"done": "done"})])
+    events = observe(sm)
+    assert sm.execute() == "done"
+    written = next(e["changes"] for e in events if e["kind"] == "userdata")
+    assert written == {"ghost": {"$repr": "<unencodable Haunted: RuntimeError>"}}

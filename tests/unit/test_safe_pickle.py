@@ -6,6 +6,7 @@ import base64
 import math
 import os
 import pickle
+import time
 
 import numpy
 import pytest
@@ -75,3 +76,41 @@ def test_python_2_str_pickles_read_as_text():
 def test_bytes_that_are_no_pickle_say_so():
     with pytest.raises(ValueError, match="no pickle"):
         safe_pickle.local_data("not a pickle")
+
+
+def shared_tuples(levels: int = 40, width: int = 10) -> bytes:
+    """The pickle of a tuple of ``width`` references to a tuple of ``width`` references to ...: a few hundred
+    bytes that hashing reads ``width ** levels`` times."""
+    value: tuple = ()
+    for _ in range(levels):
+        value = (value,) * width
+    return pickle.dumps(value, 2)[2:-1]  # without PROTO and STOP
+
+
+@pytest.mark.timeout(20)
+def test_a_dict_key_that_hashing_would_read_forever_is_refused_at_once():
+    data = b"\x80\x02}" + shared_tuples() + b"K\x01s."  # {key: 1}, written opcode by opcode: making it here would hash it
+    started = time.monotonic()
+    with pytest.raises(safe_pickle.TooCostly, match="hashing more than"):
+        safe_pickle.loads(data)
+    assert time.monotonic() - started < 2
+
+
+@pytest.mark.timeout(20)
+def test_a_set_of_such_keys_is_refused_at_once():
+    data = b"\x80\x02c__builtin__\nset\n](" + shared_tuples() + b"e\x85R."  # set([key])
+    with pytest.raises(safe_pickle.TooCostly, match="hashing more than"):
+        safe_pickle.loads(data)
+
+
+@pytest.mark.timeout(20)
+def test_a_marker_called_again_and_again_keeps_its_name():
+    data = b"\x80\x02cos\nsystem\n" + b")R" * 200_000 + b"."  # os.system()()()...
+    assert repr(safe_pickle.loads(data)) == "<opaque os.system(...)>"
+
+
+def test_a_pickle_naming_more_globals_than_are_kept_shares_one_marker_for_the_rest():
+    names = b"".join(b"cmodule\nname%d\n" % i for i in range(safe_pickle.MAX_NAMES + 1))
+    value = safe_pickle.loads(b"\x80\x02(" + names + b"l.")  # [module.name0, module.name1, ...]
+    assert value[0].type_name == "module.name0"
+    assert value[-1].type_name == "(one of more than %d globals)" % safe_pickle.MAX_NAMES

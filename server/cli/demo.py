@@ -98,7 +98,7 @@ def main(args: argparse.Namespace) -> int:
             if args.foxglove is not None:  # no hub to feed it: it observes the machine
                 from .foxglove_bridge import open_foxglove
 
-                live = open_foxglove(args.foxglove)
+                live = open_foxglove(args)
                 fsm.attach(machine, live.event)
         else:
             scene = demo.scene

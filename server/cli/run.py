@@ -57,7 +57,7 @@ def run_unserved(args: argparse.Namespace, runner: Runner, robot: ZenohRobot | N
 
     if robot is not None:
         runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
-    live = open_foxglove(args.foxglove) if args.foxglove is not None else None
+    live = open_foxglove(args) if args.foxglove is not None else None
     if live is not None:
         runner.on_machine.append(lambda name, container: fsm.attach(container, live.event))
     try:

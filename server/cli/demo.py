@@ -18,7 +18,7 @@ import time
 from typing import Any
 
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
-from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, given_of, start_server
+from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, foxglove_unused, given_of, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"
 PASSES_ARGUMENTS_ON = False
@@ -39,9 +39,10 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
-    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``."""
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``, Foxglove's without ``--foxglove``."""
     return ((args.headless and given_of(given, SERVER_OPTIONS, "has no meaning with --headless (no dashboard)"))
-            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT")) or None)
+            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT"))
+            or foxglove_unused(args, given))
 
 
 def _quiet_loggers() -> None:

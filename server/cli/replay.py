@@ -8,7 +8,7 @@ import math
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .serving import SERVER_OPTIONS, add_server_arguments, given_of, start_server, wait_for_interrupt
+from .serving import FOXGLOVE_OPTIONS, SERVER_OPTIONS, add_server_arguments, given_of, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
     from fsm.logfiles.log_reader import Reader
@@ -51,7 +51,7 @@ def play_speed(text: str) -> float:
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
     """The dashboard's options without ``--serve``, the terminal's with it; and ``--foxglove``: a
     replay is no live run (Foxglove opens the recording as a file, ``export --mcap``)."""
-    if args.foxglove is not None:
+    if args.foxglove is not None or given & set(FOXGLOVE_OPTIONS):
         return ("--foxglove serves a live run's channels; a recorded one opens in Foxglove as a file: "
                 "fsmscope export %s --mcap OUT.mcap" % args.log)
     if not args.serve:

@@ -8,8 +8,8 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
-from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, given_of, start_server,
-                      wait_for_interrupt)
+from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, foxglove_unused, given_of,
+                      start_server, wait_for_interrupt)
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -34,9 +34,10 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
-    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``."""
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``, Foxglove's without ``--foxglove``."""
     return ((args.no_serve and given_of(given, SERVER_OPTIONS, "has no meaning with --no-serve (no dashboard)"))
-            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT")) or None)
+            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT"))
+            or foxglove_unused(args, given))
 
 
 def main(args: argparse.Namespace) -> int:

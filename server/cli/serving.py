@@ -48,6 +48,12 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
 
 
 SERVER_OPTIONS = ("host", "port", "token", "viewer", "deadman", "deadman_action")  # the dashboard's
+FOXGLOVE_OPTIONS = ("foxglove_origin", "foxglove_host")  # --foxglove's
+
+
+def foxglove_unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    """``--foxglove``'s options without ``--foxglove``."""
+    return given_of(given, FOXGLOVE_OPTIONS, "needs --foxglove PORT") if args.foxglove is None else None
 
 
 def given_of(given: set[str], options: tuple[str, ...], why: str) -> str | None:

@@ -20,7 +20,10 @@ READ_AN_EVENT = """([url, topic]) => new Promise(resolve => {
   try { ws = new WebSocket(url, ["foxglove.sdk.v1"]); } catch (e) { resolve("refused: " + e.name); return; }
   ws.binaryType = "arraybuffer";
   ws.onmessage = (m) => {
-    if (typeof m.data !== "string") { resolve("read: " + new TextDecoder().decode(new Uint8Array(m.data).slice(13))); return; }
+    if (typeof m.data !== "string") {  // MessageData: op, subscription, log time, the event
+      resolve("read: " + new TextDecoder().decode(new Uint8Array(m.data).slice(13)));
+      return;
+    }
     const frame = JSON.parse(m.data);
     const channel = frame.op === "advertise" && frame.channels.find(c => c.topic === topic);
     if (channel) ws.send(JSON.stringify({op: "subscribe", subscriptions: [{id: 1, channelId: channel.id}]}));
@@ -109,7 +112,8 @@ def test_a_local_file_s_page_reads_nothing(browser, serving, tmp_path):
 def test_no_page_reads_from_the_inner_port_even_foxglove_s(browser, serving):
     live = serving()
     for scheme in ("ws", "wss"):
-        got = what_a_page_reads(browser, "https://app.foxglove.dev/", "%s://127.0.0.1:%d" % (scheme, live.door.inner_port))
+        inner = "%s://127.0.0.1:%d" % (scheme, live.door.inner_port)
+        got = what_a_page_reads(browser, "https://app.foxglove.dev/", inner)
         assert not got.startswith("read:"), scheme
 
 

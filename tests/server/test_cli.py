@@ -294,6 +294,8 @@ def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_lo
     (["demo", "--headless", "--host", "0.0.0.0"], "--host has no meaning with --headless"),
     (["demo", "--headless", "--zenoh-token", "T"], "--zenoh-token needs --zenoh ROBOT"),
     (["serve", "--zenoh-scouting"], "--zenoh-scouting needs --zenoh"),
+    (["serve", "--foxglove-origin", "null"], "--foxglove-origin needs --foxglove PORT"),
+    (["run", "SCRIPT", "--no-serve", "--foxglove-host", "robot.local"], "--foxglove-host needs --foxglove PORT"),
     (["replay", "LOG", "--speed", "2"], "--speed needs --serve"),
     (["replay", "LOG", "--token", "t"], "--token needs --serve"),
     (["replay", "LOG", "--serve", "--follow"], "--follow has no meaning with --serve"),

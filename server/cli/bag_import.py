@@ -8,6 +8,8 @@ import argparse
 import sys
 from typing import Callable, Iterator
 
+from fsm.observation.visible import terminal_text
+
 HELP = "turn a ROS bag of SMACH runs (ROS 1 .bag, ROS 2 sqlite3 or mcap), or fsmscope's MCAP, into an fsmscope log"
 PASSES_ARGUMENTS_ON = False
 EXIT_DAMAGED = 1  # the bag is damaged part way: the events before the damage were written
@@ -26,15 +28,16 @@ def convert(source: str, log: str, command: str) -> int:
     from interop.to_log import Damaged, ReadError, write_log
 
     def skipped(problem: str) -> None:
-        print("fsmscope %s: %s: skipped %s" % (command, source, problem), file=sys.stderr, flush=True)
+        print(terminal_text("fsmscope %s: %s: skipped %s" % (command, source, problem)), file=sys.stderr, flush=True)
 
     try:
         written = write_log(events_of(source, skipped), log)
     except Damaged as exc:
-        print("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written), file=sys.stderr)
+        print(terminal_text("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written)),
+              file=sys.stderr)
         return EXIT_DAMAGED
     except ReadError as exc:
-        print("fsmscope %s: %s" % (command, exc), file=sys.stderr)
+        print(terminal_text("fsmscope %s: %s" % (command, exc)), file=sys.stderr)
         return EXIT_UNREADABLE
     if command == "import":
         print("fsmscope: wrote %s (%d events)" % (log, written), file=sys.stderr)

@@ -8,6 +8,8 @@ import argparse
 import os
 import sys
 
+from fsm.observation.visible import terminal_text
+
 from .serving import given_of
 
 HELP = "write a recorded run as one HTML file that shows it in the dashboard, from disk, with no server"
@@ -41,12 +43,12 @@ def main(args: argparse.Namespace) -> int:
     from ..export_html import ExportError, export_html
 
     def skipped(problem: object) -> None:
-        print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
+        print(terminal_text("fsmscope export: %s: skipped %s" % (args.log, problem)), file=sys.stderr, flush=True)
 
     try:
         text = export_html(args.log, max_bytes=int(args.max_mb * 2**20), on_problem=skipped)
     except (ExportError, LogError) as exc:
-        print("fsmscope export: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope export: %s" % exc), file=sys.stderr)
         return EXIT_UNREADABLE
     partial = args.html + ".partial"
     with open(partial, "w", encoding="utf-8") as handle:
@@ -66,12 +68,12 @@ def export_mcap(args: argparse.Namespace) -> int:
     from .arm_frames import arm_frames
 
     def skipped(problem: object) -> None:
-        print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
+        print(terminal_text("fsmscope export: %s: skipped %s" % (args.log, problem)), file=sys.stderr, flush=True)
 
     try:
         written = write_mcap(read_events(args.log, on_problem=skipped), args.mcap, frames=arm_frames())
     except (McapLogError, LogError) as exc:
-        print("fsmscope export: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope export: %s" % exc), file=sys.stderr)
         return EXIT_UNREADABLE
     if not written:
         os.remove(args.mcap)

@@ -113,6 +113,31 @@ def test_replay_exits_1_when_the_machine_ended_in_an_error(tmp_path):
     assert "InvalidUserCodeError" in done.stdout
 
 
+# What a terminal would obey: the window's title (OSC ... BEL), clear the screen (CSI 2J), go back
+# over the line (CR, BS), the 8-bit CSI (U+009B), DEL.
+ESCAPES = "\\x1b]0;pwned\\x07\\x1b[2J\\r\\x08\\u009b31m\\x7f"
+OBEYED = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
+def test_replay_shows_the_control_characters_of_a_log_as_signs_never_raw(tmp_path):
+    script = tmp_path / "loud.py"
+    script.write_text("import fsm as smach\n"
+                      "def loud(ud):\n"
+                      "    smach.logwarn('message %s')\n"
+                      "    raise ValueError('error %s')\n"
+                      "sm = smach.StateMachine(['done'])\n"
+                      "with sm:\n"
+                      "    smach.StateMachine.add('LOUD', smach.CBState(loud, outcomes=['done']), {})\n"
+                      "sm.execute()\n" % (ESCAPES, ESCAPES))
+    log = tmp_path / "loud.jsonl"
+    assert cli("run", script, "--record", log).returncode == 1
+    done = cli("replay", log)
+    assert done.returncode == 1
+    assert not OBEYED.search(done.stdout + done.stderr), repr(OBEYED.findall(done.stdout + done.stderr))
+    assert "message \u241b]0;pwned\u2407\u241b[2J\u240d\u2408\ufffd31m\u2421" in done.stdout
+    assert "error \u241b]0;pwned" in done.stdout
+
+
 def test_replay_of_a_missing_file_is_a_one_line_error_with_exit_2(tmp_path):
     done = cli("replay", tmp_path / "missing.jsonl")
     assert done.returncode == 2

@@ -45,6 +45,9 @@ def main(args: argparse.Namespace) -> int:
     def skipped(problem: object) -> None:
         print(terminal_text("fsmscope export: %s: skipped %s" % (args.log, problem)), file=sys.stderr, flush=True)
 
+    if os.path.exists(args.html):  # as --mcap, import -o, run --record: no file is written over
+        print("fsmscope export: %s exists already" % args.html, file=sys.stderr)
+        return EXIT_UNREADABLE
     try:
         text = export_html(args.log, max_bytes=int(args.max_mb * 2**20), on_problem=skipped)
     except (ExportError, LogError) as exc:

@@ -25,7 +25,8 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="a SMACH-style script, run as __main__; arguments fsmscope does not know, and "
                              "all after '--', are passed to it")
     parser.add_argument("--record", metavar="RUN.jsonl",
-                        help="where to record the events (default: runs/<script>-<timestamp>.jsonl)")
+                        help="where to record the events, a new file (default: runs/<script>-<timestamp>.jsonl)")
+    parser.add_argument("--append", action="store_true", help="with --record: add to the log if it exists")
     parser.add_argument("--no-serve", action="store_true", help="do not serve the dashboard while it runs")
     parser.add_argument("--exit", action="store_true",
                         help="exit when the script ends instead of keeping the dashboard up")
@@ -34,16 +35,18 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
-    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``, Foxglove's without ``--foxglove``."""
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``, Foxglove's without
+    ``--foxglove``, ``--append`` without ``--record``."""
     return ((args.no_serve and given_of(given, SERVER_OPTIONS, "has no meaning with --no-serve (no dashboard)"))
             or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT"))
-            or foxglove_unused(args, given))
+            or foxglove_unused(args, given)
+            or (args.record is None and given_of(given, ("append",), "needs --record")))
 
 
 def main(args: argparse.Namespace) -> int:
     from ..runner import Runner
 
-    runner = Runner(args.script, list(args.extra), args.record)
+    runner = Runner(args.script, list(args.extra), args.record, append=args.append)
     robot = zenoh_robot(args, can_start=True)
     if args.no_serve:
         return run_unserved(args, runner, robot)
@@ -95,4 +98,4 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
     finally:
         srv.stop()
         runner.close()
-    return code
+    return runner.exit_code(code)

@@ -14,6 +14,10 @@ class ReadError(Exception):
     """The source cannot be read; the message says why."""
 
 
+class NotWritten(Exception):
+    """The log cannot be written (a full disk); no file is left. The message says why."""
+
+
 class Damaged(ReadError):
     """The source is damaged part way: ``written`` events came before the damage, and were kept."""
 
@@ -24,7 +28,8 @@ class Damaged(ReadError):
 
 def write_log(events: Iterable[dict], log: str) -> int:
     """``events`` into a new file ``log``; the number written. Raises ``ReadError`` (from the source)
-    when nothing can be read (no file is left), ``Damaged`` when part can."""
+    when nothing can be read (no file is left), ``Damaged`` when part can, ``NotWritten`` when the
+    log cannot be written whole (no file is left)."""
     if os.path.exists(log):
         raise ReadError("%s exists already: a new log is written" % log)
     written = 0
@@ -40,6 +45,8 @@ def write_log(events: Iterable[dict], log: str) -> int:
                 if not written:
                     raise
                 damage = Damaged(str(exc), written)
+        if recorder.failure is not None:
+            raise NotWritten("%s not written: %s" % (log, recorder.failure.strerror or recorder.failure))
     except BaseException:
         for path in (partial, index_path(partial)):
             if os.path.exists(path):

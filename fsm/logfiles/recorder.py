@@ -167,8 +167,8 @@ class Recorder:
                 return
             self.failure = exc
             self._buf, self._index_chunks = bytearray(), []
-        sys.stderr.write("fsm: recorder could not write %s: %s; the recording ends there (the log holds the "
-                         "events before)\n" % (self.path, exc.strerror or exc))
+        sys.stderr.write("fsm: recorder could not write %s: %s; the recording ends there\n"
+                         % (self.path, exc.strerror or exc))
 
     def _write_loop(self) -> None:
         while not self._closed and self.failure is None:

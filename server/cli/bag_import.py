@@ -13,7 +13,7 @@ from fsm.observation.visible import terminal_text
 HELP = "turn a ROS bag of SMACH runs (ROS 1 .bag, ROS 2 sqlite3 or mcap), or fsmscope's MCAP, into an fsmscope log"
 PASSES_ARGUMENTS_ON = False
 EXIT_DAMAGED = 1  # the bag is damaged part way: the events before the damage were written
-EXIT_UNREADABLE = 2  # the bag cannot be read, or holds no SMACH introspection
+EXIT_UNREADABLE = 2  # the bag cannot be read, or holds no SMACH introspection, or the log cannot be written
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -25,7 +25,7 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 def convert(source: str, log: str, command: str) -> int:
     """Write the events of ``source`` (a ROS bag, or an MCAP file fsmscope wrote) to ``log``, saying
     what happened on stderr as ``fsmscope COMMAND``; the exit code."""
-    from interop.to_log import Damaged, ReadError, write_log
+    from interop.to_log import Damaged, NotWritten, ReadError, write_log
 
     def skipped(problem: str) -> None:
         print(terminal_text("fsmscope %s: %s: skipped %s" % (command, source, problem)), file=sys.stderr, flush=True)
@@ -36,7 +36,7 @@ def convert(source: str, log: str, command: str) -> int:
         print(terminal_text("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written)),
               file=sys.stderr)
         return EXIT_DAMAGED
-    except ReadError as exc:
+    except (ReadError, NotWritten) as exc:
         print(terminal_text("fsmscope %s: %s" % (command, exc)), file=sys.stderr)
         return EXIT_UNREADABLE
     if command == "import":

@@ -202,6 +202,18 @@ def test_a_run_whose_disk_fills_says_it_once_and_exits_1_keeping_the_events_befo
     assert json.loads(replayed.stdout)["events"] > 100
 
 
+def test_an_import_whose_disk_fills_leaves_no_file_and_exits_2_saying_why(full_disk, tmp_path):
+    script = tmp_path / "busy.py"
+    script.write_text(BUSY)
+    log, mcap = tmp_path / "busy.jsonl", tmp_path / "busy.mcap"
+    assert cli("run", script, "--no-serve", "--record", log).returncode == 0
+    assert cli("export", log, "--mcap", mcap).returncode == 0
+    done = cli("import", mcap, "-o", full_disk / "busy.jsonl")
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "%s not written: No space left on device" % (full_disk / "busy.jsonl") in done.stderr
+    assert os.listdir(full_disk) == []
+
+
 def test_replay_of_a_missing_file_is_a_one_line_error_with_exit_2(tmp_path):
     done = cli("replay", tmp_path / "missing.jsonl")
     assert done.returncode == 2

@@ -214,6 +214,19 @@ def test_an_import_whose_disk_fills_leaves_no_file_and_exits_2_saying_why(full_d
     assert os.listdir(full_disk) == []
 
 
+@pytest.mark.parametrize("option", ["--html", "--mcap"])
+def test_an_export_whose_disk_fills_leaves_no_file_and_exits_2_saying_why(option, full_disk, tmp_path):
+    script = tmp_path / "busy.py"
+    script.write_text(BUSY)
+    log = tmp_path / "busy.jsonl"
+    assert cli("run", script, "--no-serve", "--record", log).returncode == 0
+    out = full_disk / "busy.out"
+    done = cli("export", log, option, out)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "%s not written: No space left on device" % out in done.stderr
+    assert os.listdir(full_disk) == []
+
+
 def test_replay_of_a_missing_file_is_a_one_line_error_with_exit_2(tmp_path):
     done = cli("replay", tmp_path / "missing.jsonl")
     assert done.returncode == 2

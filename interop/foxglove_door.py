@@ -18,7 +18,7 @@ import logging
 import socket
 import ssl
 import threading
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
@@ -81,28 +81,26 @@ def quiet_inner_port() -> None:
     logging.getLogger("foxglove.websocket.server").setLevel(logging.CRITICAL + 1)
 
 
-@dataclass
 class Door:
     """The public port's listener, on ``host``:``port`` (0: a free one, said by ``port``), in its
     own thread and event loop; each admitted connection goes to ``inner_port`` over TLS.
     ``on_first_refusal`` is told why the first refused request was (``refused`` counts them)."""
 
-    host: str
-    port: int
-    inner_port: int
-    admission: Admission
-    on_first_refusal: Callable[[str], None] = lambda reason: None
-    refused: int = 0
-    _loop: asyncio.AbstractEventLoop = field(default_factory=asyncio.new_event_loop)
-    _thread: threading.Thread | None = None
+    def __init__(self, host: str, port: int, inner_port: int, admission: Admission,
+                 on_first_refusal: Callable[[str], None] = lambda reason: None) -> None:
+        self.host, self.port, self.inner_port, self.admission = host, port, inner_port, admission
+        self.on_first_refusal = on_first_refusal
+        self.refused = 0
+        self._tls = ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT)
+        self._tls.check_hostname = False  # the inner port is ours, on the loopback: TLS is for browsers' sake
+        self._tls.verify_mode = ssl.CERT_NONE
+        self._thread: threading.Thread | None = None
 
     def start(self) -> Door:
         """Bind (raises OSError when the port is taken), then serve in a thread."""
         sock = socket.create_server((self.host, self.port))
         self.port = sock.getsockname()[1]
-        self._tls = ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT)
-        self._tls.check_hostname = False  # the inner port is ours, on the loopback: TLS is for browsers' sake
-        self._tls.verify_mode = ssl.CERT_NONE
+        self._loop = asyncio.new_event_loop()
         self._thread = threading.Thread(target=self._loop.run_forever, name="foxglove-door", daemon=True)
         self._thread.start()
         listening = asyncio.start_server(self._visit, sock=sock, limit=HEAD_LIMIT)

@@ -102,15 +102,23 @@ class Runner:
             except Exception:
                 sys.stderr.write("fsmscope: an on_machine callback failed:\n" + traceback.format_exc())
 
-    def run(self) -> int:
-        script = os.path.abspath(self.script)
-        if not os.path.isfile(script):
+    def prepare(self) -> int | None:
+        """Find the script and open the log, before anything else starts (a dashboard, a robot);
+        the exit code when either cannot be (said on stderr), else None."""
+        if not os.path.isfile(os.path.abspath(self.script)):
             sys.stderr.write("fsmscope run: %s: no such file\n" % self.script)
             return 2
         self.recorder = open_recorder(self.record_path, self.append, "run")
+        return EXIT_CANNOT_RECORD if self.recorder is None else None
+
+    def run(self) -> int:
+        """Run the script (``prepare`` first, unless done); its exit code."""
         if self.recorder is None:
-            return EXIT_CANNOT_RECORD
+            refused = self.prepare()
+            if refused is not None:
+                return refused
         sys.stderr.write("fsmscope: recording to %s\n" % self.record_path)
+        script = os.path.abspath(self.script)
         saved_argv, saved_path0 = sys.argv, sys.path[0] if sys.path else None
         sys.argv = [self.script] + list(self.args)
         if sys.path:
@@ -150,8 +158,10 @@ class Runner:
             return
         recorder.close()
         self._restore_sigterm()  # SIGTERM closed the log through SystemExit until now
-        if recorder.failure is None:
-            names = ", ".join(m.name for m in self.machines) or "no machine"
+        if recorder.failure is None and not self.machines:
+            sys.stderr.write("fsmscope: no machine ran: no log written\n")
+        elif recorder.failure is None:
+            names = ", ".join(m.name for m in self.machines)
             sys.stderr.write("fsmscope: recorded %d events (%s) to %s\n" % (recorder.events, names, self.record_path))
 
     def exit_code(self, code: int) -> int:

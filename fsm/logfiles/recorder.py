@@ -56,7 +56,8 @@ def index_path(path: str | os.PathLike) -> str:
 
 class Recorder:
     """An observer that appends every event it is given to ``path``; thread-safe. ``new``: the log
-    must not exist yet (FileExistsError), its index is written anew."""
+    must not exist yet (FileExistsError), its index is written anew, and if it is closed having
+    received nothing it is removed (a command that fails before it records leaves no file)."""
 
     def __init__(self, path: str | os.PathLike, snapshot_every: int = DEFAULT_SNAPSHOT_EVERY,
                  flush_interval: float = DEFAULT_FLUSH_INTERVAL, flush_bytes: int = DEFAULT_FLUSH_BYTES,
@@ -68,6 +69,7 @@ class Recorder:
         directory = os.path.dirname(self.path)
         if directory:
             os.makedirs(directory, exist_ok=True)
+        self._new = new
         self._file = open(self.path, "xb" if new else "ab")
         if fcntl is not None:
             fcntl.flock(self._file.fileno(), fcntl.LOCK_SH)
@@ -199,6 +201,10 @@ class Recorder:
                 except OSError as exc:
                     self._fail(exc)
                 _close_dropping_unwritten(handle)  # closing the log also releases its flock
+        if self._new and os.path.getsize(self.path) == 0:
+            for path in (self.path, index_path(self.path)):
+                if os.path.exists(path):
+                    os.remove(path)
         closing.closed(self)
 
     @property

@@ -47,6 +47,9 @@ def main(args: argparse.Namespace) -> int:
     from ..runner import Runner
 
     runner = Runner(args.script, list(args.extra), args.record, append=args.append)
+    refused = runner.prepare()  # no dashboard or robot starts for a script or log that cannot be
+    if refused is not None:
+        return refused
     robot = zenoh_robot(args, can_start=True)
     if args.no_serve:
         return run_unserved(args, runner, robot)

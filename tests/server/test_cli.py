@@ -59,6 +59,16 @@ def test_a_command_refuses_to_write_onto_an_existing_file_saying_so(command, foo
     assert out.read_bytes() == b"keep" and not marker.exists()
 
 
+def test_a_run_that_cannot_start_leaves_no_log_to_refuse_the_next_time(tmp_path):
+    log = tmp_path / "never.jsonl"
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--record", log, "--port", taken.getsockname()[1])
+    assert done.returncode == 1, done.stderr
+    assert not log.exists() and not os.path.exists(str(log) + ".idx")
+
+
 def test_run_appends_to_an_existing_log_when_asked(foo_bar_log, tmp_path):
     log = tmp_path / "twice.jsonl"
     for _ in range(2):

@@ -42,6 +42,7 @@ class Admission:
 
     @classmethod
     def allowing(cls, origins: list[str] | None = None, hosts: list[str] | None = None) -> Admission:
+        """The default admission, and ``origins`` and ``hosts`` besides (``--foxglove-origin``, ``--foxglove-host``)."""
         return cls(frozenset({FOXGLOVE_WEB_APP, *(_origin(o) for o in origins or ())}),
                    frozenset({*LOOPBACK_NAMES, *(_host_name(h) for h in hosts or ())}))
 

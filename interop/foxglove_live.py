@@ -1,5 +1,6 @@
 """The Foxglove WebSocket protocol served live with foxglove-sdk: a Foxglove user connects to
-``ws://127.0.0.1:PORT`` and sees, as they happen, the channels ``channels.py`` says (each
+``ws://127.0.0.1:PORT`` (through the door of ``foxglove_door.py``, which refuses the pages of
+other sites) and sees, as they happen, the channels ``channels.py`` says (each
 machine's events and active states, the transcript's lines, the arm's frames).
 
 ``event`` takes events in order per machine, from any thread; a machine joined mid-run starts
@@ -14,16 +15,28 @@ from typing import Callable
 import foxglove
 
 from .channels import Channels, Frame, nanoseconds
+from .foxglove_door import Admission, Door, inner_tls, quiet_inner_port
 
 
 class FoxgloveLive:
-    """A Foxglove WebSocket server on ``host``:``port`` (0: a free one, said by ``port``)."""
+    """A Foxglove WebSocket server on ``host``:``port`` (0: a free one, said by ``port``), open to
+    whom ``admission`` admits; ``on_first_refusal`` is told why the first refused request was.
+    Raises OSError when the port is taken."""
 
     def __init__(self, host: str = "127.0.0.1", port: int = 8765,
-                 frames: Callable[[dict], list[Frame]] | None = None) -> None:
+                 frames: Callable[[dict], list[Frame]] | None = None, admission: Admission = Admission(),
+                 on_first_refusal: Callable[[str], None] = lambda reason: None) -> None:
         self.context = foxglove.Context()  # its own: never the process-wide default's sinks
-        self.server = foxglove.start_server(name="fsmscope", host=host, port=port, context=self.context)
-        self.port = self.server.port
+        quiet_inner_port()
+        cert, key = inner_tls()
+        self.server = foxglove.start_server(name="fsmscope", host="127.0.0.1", port=0, context=self.context,
+                                            tls_cert=cert, tls_key=key)
+        try:
+            self.door = Door(host, port, self.server.port, admission, on_first_refusal).start()
+        except OSError:
+            self.server.stop()
+            raise
+        self.port = self.door.port
         self.channels = Channels(frames)
         self._out: dict[str, foxglove.Channel] = {}
         self._lock = threading.Lock()  # the Statuses and the transcript follow one event at a time
@@ -44,4 +57,5 @@ class FoxgloveLive:
                     channel.log(m.data if m.schema is not None else m.data.encode(), log_time=nanoseconds(m.t))
 
     def stop(self) -> None:
+        self.door.stop()
         self.server.stop()

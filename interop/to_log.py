@@ -15,6 +15,10 @@ class ReadError(Exception):
     """The source cannot be read; the message says why."""
 
 
+class NotWritten(Exception):
+    """The log cannot be written (a full disk); no file is left. The message says why."""
+
+
 class Damaged(ReadError):
     """The source is damaged part way: ``written`` events came before the damage, and were kept."""
 
@@ -32,7 +36,8 @@ def write_log(events: Iterable[dict], log: str, skipped: Callable[[str], None] |
     validator first, as replay checks each line (fsm.observation.schema.validate): one it refuses is
     not written (``skipped`` hears why), so that a log imported is one replay reads whole. Raises
     ``ReadError`` (from the source) when nothing can be read, ``NoEvents`` when no event fits (no file
-    is left then), ``Damaged`` when part can be read."""
+    is left then), ``Damaged`` when part can be read, ``NotWritten`` when the log cannot be written
+    whole (no file is left)."""
     if os.path.exists(log):
         raise ReadError("%s exists already: a new log is written" % log)
     written = refused = 0
@@ -54,6 +59,8 @@ def write_log(events: Iterable[dict], log: str, skipped: Callable[[str], None] |
                 if not written:
                     raise
                 damage = Damaged(str(exc), written)
+        if recorder.failure is not None:
+            raise NotWritten("%s not written: %s" % (log, recorder.failure.strerror or recorder.failure))
         if not written:
             raise NoEvents("no events%s" % (" (%d refused)" % refused if refused else ""))
     except BaseException:

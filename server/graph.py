@@ -27,6 +27,7 @@ import pydot
 
 from fsm.observation import structure
 from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
+from fsm.observation.visible import visible
 
 from .dot import DotError, DotPool
 
@@ -57,15 +58,11 @@ class GraphError(Exception):
     """Graphviz failed or is missing."""
 
 
-# XML cannot hold control characters (Graphviz would write them raw): a label shows each as its
-# Unicode "control picture" (U+2400 + code), ids are percent-escaped by fsm.observation.schema.
-_VISIBLE = {c: 0x2400 + c for c in range(0x20)}
-_VISIBLE.update({0x7F: 0x2421, 0xFFFE: 0xFFFD, 0xFFFF: 0xFFFD})
-
-
 def q(text: str) -> str:
-    """A DOT double-quoted string: never an HTML label, no escape sequences of dot's own."""
-    return '"%s"' % str(text).translate(_VISIBLE).replace("\\", "\\\\").replace('"', '\\"')
+    """A DOT double-quoted string: never an HTML label, no escape sequences of dot's own. XML cannot
+    hold control characters (Graphviz would write them raw): each shows as its sign
+    (fsm.observation.visible); ids are percent-escaped by fsm.observation.schema."""
+    return '"%s"' % visible(text).replace("\\", "\\\\").replace('"', '\\"')
 
 
 def open_set(root: dict, expand: Iterable[str] | None, n_states: int) -> frozenset[str]:
@@ -79,14 +76,9 @@ def open_set(root: dict, expand: Iterable[str] | None, n_states: int) -> frozens
     return frozenset(c["path"] for c in reached if c["path"] in wanted)
 
 
-def _visible(text: str) -> str:
-    """Text XML can hold: each control character as its control picture (as labels show it)."""
-    return str(text).translate(_VISIBLE)
-
-
 def described(node: dict) -> str:
     """What a state's or container's title (its tooltip) says: its path and class, never a Graphviz name."""
-    return _visible("%s (%s)" % (node["path"], node.get("type", "")))
+    return visible("%s (%s)" % (node["path"], node.get("type", "")))
 
 
 def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.Dot, dict[str, str]]:
@@ -127,7 +119,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
         name = outcome_nodes.get(outcome)
         if name is None:
             name = outcome_nodes[outcome] = "o%d" % len(outcome_nodes)
-            titles[outcome_id(path, outcome)] = _visible("%s: outcome %s" % (path, outcome))
+            titles[outcome_id(path, outcome)] = visible("%s: outcome %s" % (path, outcome))
             g.add_node(pydot.Node(name, id=q(outcome_id(path, outcome)), label=q(outcome), shape="ellipse",
                                   style="filled", fillcolor="lightgrey", **{"class": q("outcome")}))
         return name
@@ -152,7 +144,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
         seen[eid] = n + 1
         if n:
             eid += ":%d" % (n + 1)
-        titles[eid] = _visible("%s: %s --%s--> %s" % (path, tr["from"], tr["outcome"], target))
+        titles[eid] = visible("%s: %s --%s--> %s" % (path, tr["from"], tr["outcome"], target))
         attrs = {"id": q(eid), ("xlabel" if big else "label"): q(tr["outcome"])}
         if dst in outcome_set:  # edges into outcomes do not rank: many long edges to one sink explode dot
             attrs["constraint"] = "false"

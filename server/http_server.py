@@ -38,10 +38,17 @@ def bind_socket(host: str, port: int) -> socket.socket:
 
 
 def uvicorn_config(app: Any, log_level: str = "warning") -> Any:
+    """uvicorn's configuration of the app; a refused client fills no log (server/middleware.py)."""
+    import logging
+
     import uvicorn
 
-    return uvicorn.Config(app, ws=ws_implementation(), ws_per_message_deflate=False, log_level=log_level,
-                          lifespan="on", ws_max_size=8 * 1024 * 1024, access_log=False)
+    from .middleware import QUIET_CLIENTS
+
+    config = uvicorn.Config(app, ws=ws_implementation(), ws_per_message_deflate=False, log_level=log_level,
+                            lifespan="on", ws_max_size=8 * 1024 * 1024, access_log=False)
+    logging.getLogger("uvicorn.error").addFilter(QUIET_CLIENTS)  # after Config, which configures logging
+    return config
 
 
 def display_url(host: str, port: int, token: str | None) -> str:

@@ -4,10 +4,21 @@
 (``app._App.build_middleware_stack``): it answers 400 for a foreign ``Host`` (DNS rebinding)
 and 413 for a body over the limit before any route runs, and adds the hardening headers to
 every HTTP response, errors included. The token and Origin checks are the routes' (server/auth.py).
+
+Nobody unauthenticated can fill the terminal by knocking. Every refused websocket handshake goes
+through ``deny_handshake``, quietly: uvicorn's sans-I/O websocket writes an ERROR line ("ASGI
+callable returned without completing handshake") for each handshake answered with an HTTP status.
+``deny_handshake`` marks the refusal in the request's context (uvicorn writes its line in the same
+task), and ``QUIET_CLIENTS``, on uvicorn's logger, drops that line for a marked handshake only (a
+handshake the app failed to finish for another reason is still said). uvicorn's warnings about
+a client's malformed request (not HTTP, an unknown upgrade) it lets through once a minute each.
 """
 
 from __future__ import annotations
 
+import logging
+import time
+from contextvars import ContextVar
 from typing import Any
 
 import orjson
@@ -141,8 +152,38 @@ async def _json(send: Any, status: int, detail: str) -> None:
     await send({"type": "http.response.body", "body": body})
 
 
+_refused: ContextVar[bool] = ContextVar("fsmscope_refused_handshake", default=False)
+UNFINISHED = "ASGI callable returned without completing handshake."  # uvicorn's words
+MALFORMED = ("Invalid HTTP request received.", "Unsupported upgrade request.")  # uvicorn's, about a client
+MALFORMED_EVERY = 60.0  # s: each said at most once in this long
+
+
+class _QuietClients(logging.Filter):
+    """On uvicorn's logger: no line for a handshake refused on purpose, at most one a minute for
+    each kind of malformed request."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self._said: dict[str, float] = {}
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        if record.msg == UNFINISHED:
+            return not _refused.get()
+        if record.msg in MALFORMED:
+            now = time.monotonic()
+            if now - self._said.get(record.msg, -MALFORMED_EVERY) < MALFORMED_EVERY:
+                return False
+            self._said[record.msg] = now
+            record.msg = "%s (said at most once a minute)" % record.msg
+        return True
+
+
+QUIET_CLIENTS = _QuietClients()
+
+
 async def deny_handshake(scope: dict, send: Any, status: int, detail: str) -> None:
     """Refuse a websocket handshake with an HTTP status when the server can, else a 403 close."""
+    _refused.set(True)
     if "websocket.http.response" in (scope.get("extensions") or {}):
         headers, body = _error(detail)
         await send({"type": "websocket.http.response.start", "status": status, "headers": headers})

@@ -9,6 +9,9 @@ the machine's thread, before its first event).
 With ``keep_open`` the log stays open after the script ends (``fsmscope run`` keeps serving the
 dashboard, where POST .../start re-runs a machine: those runs are recorded too) until
 ``close()``, which writes what is left, fsyncs and says what was recorded.
+
+A log is never written onto unless asked (``append``): a command refuses a file that exists
+(``open_recorder``), as ``import`` and ``export`` do.
 """
 
 from __future__ import annotations
@@ -29,11 +32,30 @@ from fsm.observation.introspection import reporter_of
 from fsm.logfiles.recorder import Recorder
 
 MachineCallback = Callable[[str, Any], None]
+EXIT_NOT_RECORDED = 1  # the script ended well, but its log could not be written whole
+EXIT_CANNOT_RECORD = 2  # the log was refused (it exists) or cannot be opened: nothing ran
 
 
 def default_record_path(script: str, directory: str = "runs") -> str:
-    stem = os.path.splitext(os.path.basename(script))[0]
-    return os.path.join(directory, "%s-%s.jsonl" % (stem, time.strftime("%Y%m%d-%H%M%S")))
+    """``runs/<script>-<time>.jsonl``, or ``...-2.jsonl``, ``-3``... when a run of the same second has it."""
+    stem = "%s-%s" % (os.path.splitext(os.path.basename(script))[0], time.strftime("%Y%m%d-%H%M%S"))
+    path, n = os.path.join(directory, stem + ".jsonl"), 2
+    while os.path.exists(path):
+        path, n = os.path.join(directory, "%s-%d.jsonl" % (stem, n)), n + 1
+    return path
+
+
+def open_recorder(path: str, append: bool, command: str) -> Recorder | None:
+    """The recorder of ``path``, a new file unless ``append``; None, said on stderr as ``fsmscope
+    COMMAND``, when the file exists (and ``append`` is not given) or cannot be opened."""
+    try:
+        return Recorder(path, new=not append)
+    except FileExistsError:
+        sys.stderr.write("fsmscope %s: %s exists already: --append adds to it, or record to another file\n"
+                         % (command, path))
+    except OSError as exc:
+        sys.stderr.write("fsmscope %s: cannot record to %s: %s\n" % (command, path, exc.strerror or exc))
+    return None
 
 
 @dataclass
@@ -49,6 +71,7 @@ class Runner:
     script: str
     args: list[str] = field(default_factory=list)
     record: str | None = None  # path of the log; None: runs/<script>-<timestamp>.jsonl
+    append: bool = False  # add to the log when it exists (else it is refused)
     on_machine: list[MachineCallback] = field(default_factory=list)
     machines: list[Machine] = field(default_factory=list)
     recorder: Recorder | None = None
@@ -79,13 +102,23 @@ class Runner:
             except Exception:
                 sys.stderr.write("fsmscope: an on_machine callback failed:\n" + traceback.format_exc())
 
-    def run(self) -> int:
-        script = os.path.abspath(self.script)
-        if not os.path.isfile(script):
+    def prepare(self) -> int | None:
+        """Find the script and open the log, before anything else starts (a dashboard, a robot);
+        the exit code when either cannot be (said on stderr), else None."""
+        if not os.path.isfile(os.path.abspath(self.script)):
             sys.stderr.write("fsmscope run: %s: no such file\n" % self.script)
             return 2
-        self.recorder = Recorder(self.record_path)
+        self.recorder = open_recorder(self.record_path, self.append, "run")
+        return EXIT_CANNOT_RECORD if self.recorder is None else None
+
+    def run(self) -> int:
+        """Run the script (``prepare`` first, unless done); its exit code."""
+        if self.recorder is None:
+            refused = self.prepare()
+            if refused is not None:
+                return refused
         sys.stderr.write("fsmscope: recording to %s\n" % self.record_path)
+        script = os.path.abspath(self.script)
         saved_argv, saved_path0 = sys.argv, sys.path[0] if sys.path else None
         sys.argv = [self.script] + list(self.args)
         if sys.path:
@@ -112,20 +145,30 @@ class Runner:
                 sys.path[0] = saved_path0
             if not self.keep_open:
                 self.close()
-        return code
+        return code if self.keep_open else self.exit_code(code)
 
     def _note_signal(self, signum: int) -> None:
         self.signalled = signum
 
     def close(self) -> None:
-        """Close the log (write, fsync) and say what it holds; idempotent."""
+        """Close the log (write, fsync) and say what it holds (a failed write the recorder said
+        already); idempotent."""
         recorder = self.recorder
         if recorder is None or recorder.closed:
             return
         recorder.close()
         self._restore_sigterm()  # SIGTERM closed the log through SystemExit until now
-        names = ", ".join(m.name for m in self.machines) or "no machine"
-        sys.stderr.write("fsmscope: recorded %d events (%s) to %s\n" % (recorder.events, names, self.record_path))
+        if recorder.failure is None and not self.machines:
+            sys.stderr.write("fsmscope: no machine ran: no log written\n")
+        elif recorder.failure is None:
+            names = ", ".join(m.name for m in self.machines)
+            sys.stderr.write("fsmscope: recorded %d events (%s) to %s\n" % (recorder.events, names, self.record_path))
+
+    def exit_code(self, code: int) -> int:
+        """The command's exit code for a script that exited ``code``: EXIT_NOT_RECORDED instead of 0
+        when its log could not be written whole (a full disk)."""
+        failed = self.recorder is not None and self.recorder.failure is not None
+        return EXIT_NOT_RECORDED if code == 0 and failed else code
 
 
 def _exit_code(code: Any) -> int:

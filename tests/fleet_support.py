@@ -195,7 +195,8 @@ class Router:
 class Robot:
     """Robot ``name`` in a real process: ``fsmscope run robots/patrol.py --no-serve --zenoh NAME``,
     connecting to ``endpoint`` and recording to ``log``; ``fail``: its patrol fails on the third scan;
-    ``options``: more of ``run``'s (``--zenoh-mode client``, behind a router)."""
+    ``options``: more of ``run``'s (``--zenoh-mode client``, behind a router). Restarted
+    (``start`` again), it appends to its log, as a robot's service would (``--append``)."""
 
     def __init__(self, name: str, endpoint: str, token: str, log: Path, fail: bool = False,
                  options: tuple[str, ...] = ()) -> None:
@@ -206,7 +207,7 @@ class Robot:
 
     def start(self) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "server.cli", "run", str(PATROL), "--no-serve", "--record", str(self.log),
+            [sys.executable, "-m", "server.cli", "run", str(PATROL), "--no-serve", "--record", str(self.log), "--append",
              "--zenoh", self.name, "--zenoh-connect", self.endpoint, "--zenoh-token", self.token, *self.options,
              *(["--", "fail"] if self.fail else [])],
             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)

@@ -23,7 +23,8 @@ class BreakpointError(ValueError):
 @dataclass(frozen=True)
 class Breakpoint:
     """``state`` is the state's path (``/SM_ROOT/PICK/CLOSE``); ``outcome`` only for ``at="after"``;
-    ``when`` a condition (fsm.debugging.condition) over the userdata of the state's container."""
+    ``when`` a condition (fsm.debugging.condition) over the userdata of the state's container;
+    a blank one (``""``, spaces) is none, as null is."""
 
     state: str
     at: str = "before"
@@ -49,11 +50,12 @@ class Breakpoint:
             raise BreakpointError("outcome must be a string, and only for a breakpoint after the state", "outcome")
         if when is not None and not isinstance(when, str):
             raise BreakpointError("when must be a condition's text", "when")
+        when = (when or "").strip() or None  # blank: no condition, as the page's dialog sends it
         try:
             condition = Condition(when) if when else None
         except ConditionError as err:
             raise BreakpointError("when: %s" % err, "when") from None
-        return cls(state, at, outcome, when or None, condition)
+        return cls(state, at, outcome, when, condition)
 
     def to_dict(self) -> dict:
         """Its JSON form, the schema's breakpoint."""

@@ -13,11 +13,16 @@ log from its start (``fsm.logfiles.log_reader.seek``).
 
 While open, the recorder holds a shared ``flock`` on the log: a reader that can take an
 exclusive lock knows that nobody writes the file any more (``fsm.logfiles.log_reader.follow``).
+
+A write that fails (a full disk) ends the recording there, said once on stderr: the log holds
+the events before it (a last line cut short is skipped by readers), later events are dropped,
+the machine runs on, ``close()`` raises nothing and ``failure`` says why.
 """
 
 from __future__ import annotations
 
 import os
+import sys
 import threading
 import time
 from typing import Any
@@ -50,11 +55,13 @@ def index_path(path: str | os.PathLike) -> str:
 
 
 class Recorder:
-    """An observer that appends every event it is given to ``path``; thread-safe."""
+    """An observer that appends every event it is given to ``path``; thread-safe. ``new``: the log
+    must not exist yet (FileExistsError), its index is written anew, and if it is closed having
+    received nothing it is removed (a command that fails before it records leaves no file)."""
 
     def __init__(self, path: str | os.PathLike, snapshot_every: int = DEFAULT_SNAPSHOT_EVERY,
                  flush_interval: float = DEFAULT_FLUSH_INTERVAL, flush_bytes: int = DEFAULT_FLUSH_BYTES,
-                 index: bool = True) -> None:
+                 index: bool = True, new: bool = False) -> None:
         self.path = os.fspath(path)
         self.snapshot_every = max(1, int(snapshot_every))
         self.flush_interval = flush_interval
@@ -62,10 +69,11 @@ class Recorder:
         directory = os.path.dirname(self.path)
         if directory:
             os.makedirs(directory, exist_ok=True)
-        self._file = open(self.path, "ab")
+        self._new = new
+        self._file = open(self.path, "xb" if new else "ab")
         if fcntl is not None:
             fcntl.flock(self._file.fileno(), fcntl.LOCK_SH)
-        self._index = open(index_path(self.path), "ab") if index else None
+        self._index = open(index_path(self.path), "wb" if new else "ab") if index else None
         self._taken = self._file.seek(0, os.SEEK_END)  # bytes handed to the writer so far
         self._lock = threading.Lock()  # guards the buffers and statuses
         self._io_lock = threading.Lock()  # one writer to the files at a time
@@ -79,6 +87,7 @@ class Recorder:
         self.snapshots = 0
         self.machines: list[str] = []
         self._closed = False
+        self.failure: OSError | None = None  # the write that ended the recording, if one did
         self._wake = threading.Event()
         self._writer = threading.Thread(target=self._write_loop, name="fsm-recorder", daemon=True)
         self._writer.start()
@@ -89,7 +98,7 @@ class Recorder:
     def __call__(self, event: dict) -> None:
         data = encoding.encoded(event)
         with self._lock:
-            if self._closed:
+            if self._closed or self.failure is not None:
                 return
             buf = self._buf
             buf += data
@@ -138,32 +147,40 @@ class Recorder:
             return data, b"".join(index_chunks)
 
     def flush(self) -> None:
-        """Write and flush everything recorded so far (no fsync)."""
+        """Write and flush everything recorded so far (no fsync); after a failed write, nothing."""
         with self._io_lock:
             data, index = self._take()
-            if self._file.closed:
+            if self._file.closed or self.failure is not None:
                 return
-            if data:
-                self._file.write(data)
-                self._file.flush()
-            if index and self._index is not None:  # after the log, so an offset never points past its data
-                self._index.write(index)
-                self._index.flush()
+            try:
+                if data:
+                    self._file.write(data)
+                    self._file.flush()
+                if index and self._index is not None:  # after the log, so an offset never points past its data
+                    self._index.write(index)
+                    self._index.flush()
+            except OSError as exc:
+                self._fail(exc)
+
+    def _fail(self, exc: OSError) -> None:
+        """The recording ends at the first write that failed: said once, the events after it dropped."""
+        with self._lock:
+            if self.failure is not None:
+                return
+            self.failure = exc
+            self._buf, self._index_chunks = bytearray(), []
+        sys.stderr.write("fsm: recorder could not write %s: %s; the recording ends there\n"
+                         % (self.path, exc.strerror or exc))
 
     def _write_loop(self) -> None:
-        while not self._closed:
+        while not self._closed and self.failure is None:
             self._wake.wait(self.flush_interval)
             self._wake.clear()
-            try:
-                self.flush()
-            except (OSError, ValueError) as exc:  # disk full, file closed under us: keep the machine running
-                if not self._closed:
-                    import sys
-                    sys.stderr.write("fsm: recorder could not write %s: %s\n" % (self.path, exc))
-                    time.sleep(self.flush_interval)
+            self.flush()
 
     def close(self) -> None:
-        """Write what is left, fsync and close; later events are dropped. Idempotent."""
+        """Write what is left, fsync and close; later events are dropped. Idempotent; raises nothing
+        on a failed write (``failure`` says it)."""
         with self._lock:
             if self._closed:
                 return
@@ -176,11 +193,18 @@ class Recorder:
             for handle, chunk in ((self._file, data), (self._index, index)):
                 if handle is None:
                     continue
-                if chunk:
-                    handle.write(chunk)
-                handle.flush()
-                os.fsync(handle.fileno())
-                handle.close()  # closing the log also releases its flock
+                try:
+                    if chunk and self.failure is None:
+                        handle.write(chunk)
+                    handle.flush()
+                    os.fsync(handle.fileno())
+                except OSError as exc:
+                    self._fail(exc)
+                _close_dropping_unwritten(handle)  # closing the log also releases its flock
+        if self._new and os.path.getsize(self.path) == 0:
+            for path in (self.path, index_path(self.path)):
+                if os.path.exists(path):
+                    os.remove(path)
         closing.closed(self)
 
     @property
@@ -195,3 +219,12 @@ class Recorder:
 
     def __repr__(self) -> str:
         return "Recorder(%r, events=%d%s)" % (self.path, self.events, ", closed" if self._closed else "")
+
+
+def _close_dropping_unwritten(handle: Any) -> None:
+    """Close ``handle``; what a failed write left in its buffer is dropped (closing tries to write
+    it again, fails again, and closes the file all the same)."""
+    try:
+        handle.close()
+    except OSError:
+        pass

@@ -8,10 +8,13 @@ import argparse
 import sys
 from typing import Callable, Iterator
 
+from fsm.observation.visible import terminal_text
+
 HELP = "turn a ROS bag of SMACH runs (ROS 1 .bag, ROS 2 sqlite3 or mcap), or fsmscope's MCAP, into an fsmscope log"
 PASSES_ARGUMENTS_ON = False
 EXIT_DAMAGED = 1  # the bag is damaged part way: the events before the damage were written
-EXIT_UNREADABLE = 2  # the bag cannot be read, or holds no SMACH introspection, or no event that fits the schema
+EXIT_UNREADABLE = 2  # the bag cannot be read, holds no SMACH introspection or no event that fits the schema,
+                     # or the log cannot be written
 SHOWN = 300  # characters of a reason a skipped line shows
 
 
@@ -24,22 +27,23 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 def convert(source: str, log: str, command: str) -> int:
     """Write the events of ``source`` (a ROS bag, or an MCAP file fsmscope wrote) to ``log``, saying
     what happened on stderr as ``fsmscope COMMAND``; the exit code."""
-    from interop.to_log import Damaged, NoEvents, ReadError, write_log
+    from interop.to_log import Damaged, NoEvents, NotWritten, ReadError, write_log
 
     def skipped(problem: str) -> None:
         shown = problem if len(problem) <= SHOWN else problem[:SHOWN] + "…"  # its words may quote a huge path
-        print("fsmscope %s: %s: skipped %s" % (command, source, shown), file=sys.stderr, flush=True)
+        print(terminal_text("fsmscope %s: %s: skipped %s" % (command, source, shown)), file=sys.stderr, flush=True)
 
     try:
         written = write_log(events_of(source, skipped), log, skipped)
     except Damaged as exc:
-        print("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written), file=sys.stderr)
+        print(terminal_text("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written)),
+              file=sys.stderr)
         return EXIT_DAMAGED
     except NoEvents as exc:
-        print("fsmscope %s: %s: %s" % (command, source, exc), file=sys.stderr)
+        print(terminal_text("fsmscope %s: %s: %s" % (command, source, exc)), file=sys.stderr)
         return EXIT_UNREADABLE
-    except ReadError as exc:
-        print("fsmscope %s: %s" % (command, exc), file=sys.stderr)
+    except (ReadError, NotWritten) as exc:
+        print(terminal_text("fsmscope %s: %s" % (command, exc)), file=sys.stderr)
         return EXIT_UNREADABLE
     if command == "import":
         print("fsmscope: wrote %s (%d events)" % (log, written), file=sys.stderr)

@@ -10,15 +10,13 @@ no server and no 3D view, for CI and post-mortems (``fsmscope replay`` reads its
 from __future__ import annotations
 
 import argparse
-import os
 import signal
 import sys
 import threading
-import time
 from typing import Any
 
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
-from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, given_of, start_server
+from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, foxglove_unused, given_of, start_server
 
 HELP = "pick-and-place on a simulated MuJoCo arm, with the dashboard and the 3D view"
 PASSES_ARGUMENTS_ON = False
@@ -30,7 +28,8 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="no dashboard, no 3D view: episodes and a recording only")
     parser.add_argument("--episodes", type=int, default=0, help="episodes to run (0: until stopped)")
     parser.add_argument("--record", metavar="FILE",
-                        help="the log of every episode (default: runs/demo-<time>.jsonl)")
+                        help="the log of every episode, a new file (default: runs/demo-<time>.jsonl)")
+    parser.add_argument("--append", action="store_true", help="with --record: add to the log if it exists")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first episode")
     parser.add_argument("--fast", action="store_true", help="physics as fast as possible, not real time")
     add_server_arguments(parser, 0)
@@ -39,9 +38,12 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
-    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``."""
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``, Foxglove's without
+    ``--foxglove``, ``--append`` without ``--record``."""
     return ((args.headless and given_of(given, SERVER_OPTIONS, "has no meaning with --headless (no dashboard)"))
-            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT")) or None)
+            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT"))
+            or foxglove_unused(args, given)
+            or (args.record is None and given_of(given, ("append",), "needs --record")))
 
 
 def _quiet_loggers() -> None:
@@ -64,19 +66,27 @@ def main(args: argparse.Namespace) -> int:
     with the 3D view; until the episodes are done, Ctrl-C or SIGTERM. Everything is undone on exit."""
     import fsm
     from fsm.control.handle import MachineHandle
-    from fsm.logfiles.recorder import Recorder
     from fsm.observation import schema
     from sim.demo import SimDemo
     from sim.pose import PoseTap
 
+    from ..runner import EXIT_CANNOT_RECORD, EXIT_NOT_RECORDED, default_record_path, open_recorder
+
     if not args.verbose:
         _quiet_loggers()
     robot = zenoh_robot(args, can_start=False)  # first: an endpoint Zenoh cannot use ends the command before it starts
-    record_path = args.record or os.path.join("runs", time.strftime("demo-%Y%m%d-%H%M%S.jsonl"))
-    os.makedirs(os.path.dirname(os.path.abspath(record_path)), exist_ok=True)
-    demo = SimDemo(seed=args.seed, fast=args.fast, scene=not args.headless)
+    record_path = args.record or default_record_path("demo")
+    recorder = open_recorder(record_path, args.append, "demo")
+    if recorder is None:
+        if robot is not None:
+            robot.close()
+        return EXIT_CANNOT_RECORD
+    try:
+        demo = SimDemo(seed=args.seed, fast=args.fast, scene=not args.headless)
+    except BaseException:
+        recorder.close()
+        raise
     machine = demo.build_machine()
-    recorder = Recorder(record_path)
     rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
 
     def record_pose(fields: dict) -> bool:
@@ -98,7 +108,7 @@ def main(args: argparse.Namespace) -> int:
             if args.foxglove is not None:  # no hub to feed it: it observes the machine
                 from .foxglove_bridge import open_foxglove
 
-                live = open_foxglove(args.foxglove)
+                live = open_foxglove(args)
                 fsm.attach(machine, live.event)
         else:
             scene = demo.scene
@@ -150,9 +160,12 @@ def main(args: argparse.Namespace) -> int:
         recorder.close()
         for s, h in old.items():
             signal.signal(s, h)
-    print("fsmscope demo: %d episode(s) recorded to %s" % (len(results), record_path), flush=True)
+    if recorder.failure is None:  # else the recorder said where the recording ended
+        print("fsmscope demo: %d episode(s) recorded to %s" % (len(results), record_path), flush=True)
     if failure:
         raise failure[0]
     if interrupted:
         return 128 + interrupted[0]  # as a shell reports a process ended by that signal: 130 Ctrl-C, 143 SIGTERM
+    if recorder.failure is not None:
+        return EXIT_NOT_RECORDED
     return 0 if results and all(r["outcome"] == "succeeded" for r in results) else 1

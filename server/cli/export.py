@@ -8,11 +8,13 @@ import argparse
 import os
 import sys
 
+from fsm.observation.visible import terminal_text
+
 from .serving import given_of
 
 HELP = "write a recorded run as one HTML file that shows it in the dashboard, from disk, with no server"
 PASSES_ARGUMENTS_ON = False
-EXIT_UNREADABLE = 2  # the log cannot be read or exported
+EXIT_UNREADABLE = 2  # the log cannot be read or exported, or the file cannot be written
 
 
 def arguments(parser: argparse.ArgumentParser) -> None:
@@ -41,16 +43,23 @@ def main(args: argparse.Namespace) -> int:
     from ..export_html import ExportError, export_html
 
     def skipped(problem: object) -> None:
-        print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
+        print(terminal_text("fsmscope export: %s: skipped %s" % (args.log, problem)), file=sys.stderr, flush=True)
 
+    if os.path.exists(args.html):  # as --mcap, import -o, run --record: no file is written over
+        print("fsmscope export: %s exists already" % args.html, file=sys.stderr)
+        return EXIT_UNREADABLE
     try:
         text = export_html(args.log, max_bytes=int(args.max_mb * 2**20), on_problem=skipped)
     except (ExportError, LogError) as exc:
-        print("fsmscope export: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope export: %s" % exc), file=sys.stderr)
         return EXIT_UNREADABLE
     partial = args.html + ".partial"
-    with open(partial, "w", encoding="utf-8") as handle:
-        handle.write(text)
+    try:
+        with open(partial, "w", encoding="utf-8") as handle:
+            handle.write(text)
+    except OSError as exc:
+        os.remove(partial)
+        return not_written(args.html, exc)
     os.replace(partial, args.html)
     print("fsmscope: wrote %s (%.1f MB); open it in a browser" % (args.html, len(text.encode()) / 2**20),
           file=sys.stderr)
@@ -66,13 +75,15 @@ def export_mcap(args: argparse.Namespace) -> int:
     from .arm_frames import arm_frames
 
     def skipped(problem: object) -> None:
-        print("fsmscope export: %s: skipped %s" % (args.log, problem), file=sys.stderr, flush=True)
+        print(terminal_text("fsmscope export: %s: skipped %s" % (args.log, problem)), file=sys.stderr, flush=True)
 
     try:
         written = write_mcap(read_events(args.log, on_problem=skipped), args.mcap, frames=arm_frames())
     except (McapLogError, LogError) as exc:
-        print("fsmscope export: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope export: %s" % exc), file=sys.stderr)
         return EXIT_UNREADABLE
+    except OSError as exc:  # reading the log says LogError: this is the writing (a full disk); no file is left
+        return not_written(args.mcap, exc)
     if not written:
         os.remove(args.mcap)
         print("fsmscope export: %s: no events" % args.log, file=sys.stderr)
@@ -80,3 +91,8 @@ def export_mcap(args: argparse.Namespace) -> int:
     print("fsmscope: wrote %s (%d events)" % (args.mcap, written), file=sys.stderr)
     return 0
 
+
+def not_written(out: str, exc: OSError) -> int:
+    """Say that ``out`` could not be written (a full disk) and was not left behind; the exit code."""
+    print("fsmscope export: %s not written: %s" % (out, exc.strerror or exc), file=sys.stderr)
+    return EXIT_UNREADABLE

@@ -26,26 +26,40 @@ POLL_SECONDS = 0.05
 BATCH = 2000  # events of one machine taken per poll at most
 
 
-def open_foxglove(port: int) -> FoxgloveLive:
-    """The Foxglove server on 127.0.0.1 and ``port``, said on stderr. Foxglove's protocol has no
-    token: it is never served on another address than the loopback, whatever ``--host`` says (reach
-    it from elsewhere through an SSH tunnel). Raises CannotServe."""
+def open_foxglove(args: argparse.Namespace) -> FoxgloveLive:
+    """The Foxglove server on 127.0.0.1 and ``--foxglove``, said on stderr with who may connect.
+    Foxglove's protocol has no token: it is never served on another address than the loopback,
+    whatever ``--host`` says (reach it from elsewhere through an SSH tunnel), and its door refuses
+    web pages but Foxglove's and those of ``--foxglove-origin``, and Host names but the loopback's
+    and those of ``--foxglove-host`` (interop/foxglove_door.py). Raises CannotServe."""
+    from interop.foxglove_door import FOXGLOVE_WEB_APP, LOOPBACK_NAMES, Admission
     from interop.foxglove_live import FoxgloveLive
 
     from .arm_frames import arm_frames
 
+    admission = Admission.allowing(args.foxglove_origin, args.foxglove_host)
     try:
-        live = FoxgloveLive(LOOPBACK, port, frames=arm_frames())
-    except RuntimeError as exc:  # foxglove-sdk's: the port is taken
+        live = FoxgloveLive(LOOPBACK, args.foxglove, frames=arm_frames(), admission=admission,
+                            on_first_refusal=_say_refused)
+    except (RuntimeError, OSError) as exc:  # foxglove-sdk's or the door's: the port is taken
         raise CannotServe("the Foxglove server cannot start: %s" % exc) from exc
-    print("fsmscope: Foxglove WebSocket at ws://%s:%d (no token: this computer only)" % (LOOPBACK, live.port),
+    origins = [FOXGLOVE_WEB_APP, *sorted(admission.origins - {FOXGLOVE_WEB_APP})]
+    hosts = sorted(admission.hosts - LOOPBACK_NAMES)
+    print("fsmscope: Foxglove WebSocket at ws://%s:%d (no token: programs of this computer and web pages of %s "
+          "may connect; other pages are refused%s)" % (LOOPBACK, live.port, ", ".join(origins),
+                                                        "; also named %s" % ", ".join(hosts) if hosts else ""),
           file=sys.stderr, flush=True)
     return live
 
 
+def _say_refused(reason: str) -> None:
+    print("fsmscope: a Foxglove connection was refused: %s (--foxglove-origin, --foxglove-host allow more); "
+          "further refusals are not said" % reason, file=sys.stderr, flush=True)
+
+
 def start_foxglove(args: argparse.Namespace, hub: Hub) -> FoxgloveLive:
     """The Foxglove server on ``--foxglove``, fed from ``hub`` until the process ends."""
-    live = open_foxglove(args.foxglove)
+    live = open_foxglove(args)
     asyncio.run_coroutine_threadsafe(_pump(hub, live), hub.loop)
     return live
 

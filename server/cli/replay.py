@@ -8,7 +8,9 @@ import math
 import sys
 from typing import TYPE_CHECKING, Any
 
-from .serving import SERVER_OPTIONS, add_server_arguments, given_of, start_server, wait_for_interrupt
+from fsm.observation.visible import terminal_text
+
+from .serving import FOXGLOVE_OPTIONS, SERVER_OPTIONS, add_server_arguments, given_of, start_server, wait_for_interrupt
 
 if TYPE_CHECKING:
     from fsm.logfiles.log_reader import Reader
@@ -51,7 +53,7 @@ def play_speed(text: str) -> float:
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
     """The dashboard's options without ``--serve``, the terminal's with it; and ``--foxglove``: a
     replay is no live run (Foxglove opens the recording as a file, ``export --mcap``)."""
-    if args.foxglove is not None:
+    if args.foxglove is not None or given & set(FOXGLOVE_OPTIONS):
         return ("--foxglove serves a live run's channels; a recorded one opens in Foxglove as a file: "
                 "fsmscope export %s --mcap OUT.mcap" % args.log)
     if not args.serve:
@@ -93,7 +95,7 @@ def reader_of(log: str) -> Reader:
     """The log's reader; each line it skips is said on stderr as it goes."""
     from fsm.logfiles.log_reader import Reader
 
-    return Reader(log, on_problem=lambda p: print("fsmscope replay: %s: skipped %s" % (log, p),
+    return Reader(log, on_problem=lambda p: print(terminal_text("fsmscope replay: %s: skipped %s" % (log, p)),
                                                   file=sys.stderr, flush=True))
 
 
@@ -123,11 +125,11 @@ def replay_in_terminal(args: argparse.Namespace) -> int:
             summary.add(event)
             if show:
                 for line in transcript.lines(event):
-                    out.write(transcript.format(line, not args.no_time) + "\n")
+                    out.write(terminal_text(transcript.format(line, not args.no_time)) + "\n")
                 if args.follow:
                     out.flush()
     except LogError as exc:
-        print("fsmscope replay: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope replay: %s" % exc), file=sys.stderr)
         return EXIT_UNREADABLE
     except KeyboardInterrupt:
         pass
@@ -141,7 +143,7 @@ def replay_in_terminal(args: argparse.Namespace) -> int:
     else:
         if show:
             out.write("\n")
-        out.write(summary.format() + "\n")
+        out.write(terminal_text(summary.format()) + "\n")
     return summary.exit_code()
 
 
@@ -176,7 +178,7 @@ def replay_in_browser(args: argparse.Namespace) -> int:
     try:
         count = load(hub, reader, args.speed)
     except LogError as exc:
-        print("fsmscope replay: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope replay: %s" % exc), file=sys.stderr)
         return EXIT_UNREADABLE
     except KeyboardInterrupt:
         return 0
@@ -208,5 +210,5 @@ def pose_scene(hub: Hub) -> Any:
     try:
         return start_pose_scene({"joints": pose["joints"], "bodies": pose["bodies"]})
     except ValueError as exc:  # a pose of another robot than the demo's arm
-        print("fsmscope replay: no 3D view: %s" % exc, file=sys.stderr)
+        print(terminal_text("fsmscope replay: no 3D view: %s" % exc), file=sys.stderr)
         return None

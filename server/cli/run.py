@@ -8,8 +8,8 @@ import sys
 from typing import TYPE_CHECKING, Any
 
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
-from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, given_of, start_server,
-                      wait_for_interrupt)
+from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, foxglove_unused, given_of,
+                      start_server, wait_for_interrupt)
 
 if TYPE_CHECKING:
     from fleet.robot import ZenohRobot
@@ -25,7 +25,8 @@ def arguments(parser: argparse.ArgumentParser) -> None:
                         help="a SMACH-style script, run as __main__; arguments fsmscope does not know, and "
                              "all after '--', are passed to it")
     parser.add_argument("--record", metavar="RUN.jsonl",
-                        help="where to record the events (default: runs/<script>-<timestamp>.jsonl)")
+                        help="where to record the events, a new file (default: runs/<script>-<timestamp>.jsonl)")
+    parser.add_argument("--append", action="store_true", help="with --record: add to the log if it exists")
     parser.add_argument("--no-serve", action="store_true", help="do not serve the dashboard while it runs")
     parser.add_argument("--exit", action="store_true",
                         help="exit when the script ends instead of keeping the dashboard up")
@@ -34,15 +35,21 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
-    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``."""
+    """The dashboard's options without a dashboard, Zenoh's without ``--zenoh``, Foxglove's without
+    ``--foxglove``, ``--append`` without ``--record``."""
     return ((args.no_serve and given_of(given, SERVER_OPTIONS, "has no meaning with --no-serve (no dashboard)"))
-            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT")) or None)
+            or (args.zenoh is None and given_of(given, ZENOH_OPTIONS, "needs --zenoh ROBOT"))
+            or foxglove_unused(args, given)
+            or (args.record is None and given_of(given, ("append",), "needs --record")))
 
 
 def main(args: argparse.Namespace) -> int:
     from ..runner import Runner
 
-    runner = Runner(args.script, list(args.extra), args.record)
+    runner = Runner(args.script, list(args.extra), args.record, append=args.append)
+    refused = runner.prepare()  # no dashboard or robot starts for a script or log that cannot be
+    if refused is not None:
+        return refused
     robot = zenoh_robot(args, can_start=True)
     if args.no_serve:
         return run_unserved(args, runner, robot)
@@ -57,7 +64,7 @@ def run_unserved(args: argparse.Namespace, runner: Runner, robot: ZenohRobot | N
 
     if robot is not None:
         runner.on_machine.append(lambda name, container: fsm.attach(container, robot, name=name))
-    live = open_foxglove(args.foxglove) if args.foxglove is not None else None
+    live = open_foxglove(args) if args.foxglove is not None else None
     if live is not None:
         runner.on_machine.append(lambda name, container: fsm.attach(container, live.event))
     try:
@@ -94,4 +101,4 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
     finally:
         srv.stop()
         runner.close()
-    return code
+    return runner.exit_code(code)

@@ -9,7 +9,7 @@ import sys
 
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments
 from .cannot_serve import CannotServe
-from .serving import add_server_arguments, announce_viewer, given_of, start_server, wait_for_interrupt
+from .serving import add_server_arguments, announce_viewer, foxglove_unused, given_of, start_server, wait_for_interrupt
 
 HELP = "serve the dashboard for machines of other processes (they publish to /api/ingest)"
 PASSES_ARGUMENTS_ON = False
@@ -22,7 +22,8 @@ def arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def unused(args: argparse.Namespace, given: set[str]) -> str | None:
-    return given_of(given, ZENOH_OPTIONS, "needs --zenoh") if args.zenoh is None else None
+    zenoh = given_of(given, ZENOH_OPTIONS, "needs --zenoh") if args.zenoh is None else None
+    return zenoh or foxglove_unused(args, given)
 
 
 def main(args: argparse.Namespace) -> int:

@@ -10,6 +10,7 @@ import threading
 from typing import TYPE_CHECKING, Any
 
 from fsm.control.frames import DEADMAN_ACTIONS
+from interop.foxglove_door import FOXGLOVE_WEB_APP
 
 from ..lease import Deadman
 from .cannot_serve import CannotServe
@@ -38,9 +39,21 @@ def add_server_arguments(parser: argparse.ArgumentParser, default_port: int) -> 
                         help="also serve the Foxglove WebSocket protocol on this port (0: a free one), on 127.0.0.1 "
                              "only (it has no token): each machine's events and active states, the log, the "
                              "arm's frames")
+    parser.add_argument("--foxglove-origin", action="append", metavar="ORIGIN",
+                        help="a web page's origin that may connect to --foxglove besides Foxglove's web app "
+                             "(%s), e.g. null for a local file's page; repeatable" % FOXGLOVE_WEB_APP)
+    parser.add_argument("--foxglove-host", action="append", metavar="NAME",
+                        help="a Host name that --foxglove answers besides the loopback's (127.0.0.1, localhost, "
+                             "::1); repeatable")
 
 
 SERVER_OPTIONS = ("host", "port", "token", "viewer", "deadman", "deadman_action")  # the dashboard's
+FOXGLOVE_OPTIONS = ("foxglove_origin", "foxglove_host")  # --foxglove's
+
+
+def foxglove_unused(args: argparse.Namespace, given: set[str]) -> str | None:
+    """``--foxglove``'s options without ``--foxglove``."""
+    return given_of(given, FOXGLOVE_OPTIONS, "needs --foxglove PORT") if args.foxglove is None else None
 
 
 def given_of(given: set[str], options: tuple[str, ...], why: str) -> str | None:

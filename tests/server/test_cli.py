@@ -42,6 +42,42 @@ def test_run_records_to_the_given_path_and_says_where(foo_bar_log):
     assert foo_bar_log.exists() and os.path.exists(str(foo_bar_log) + ".idx")
 
 
+@pytest.mark.parametrize("command", [
+    ["run", "SCRIPT", "--no-serve", "--record", "OUT"],
+    ["demo", "--headless", "--record", "OUT"],
+    ["export", "LOG", "--html", "OUT"],
+    ["export", "LOG", "--mcap", "OUT"],
+], ids=lambda v: " ".join(v[:2]))
+def test_a_command_refuses_to_write_onto_an_existing_file_saying_so(command, foo_bar_log, tmp_path):
+    out = tmp_path / "existing"
+    out.write_bytes(b"keep")
+    marker = tmp_path / "ran"
+    script = tmp_path / "script.py"
+    script.write_text("open(%r, 'w').close()\n" % str(marker))
+    done = cli(*[{"SCRIPT": script, "LOG": foo_bar_log, "OUT": out}.get(a, a) for a in command])
+    assert done.returncode == 2 and "%s exists already" % out in done.stderr, done.stderr
+    assert out.read_bytes() == b"keep" and not marker.exists()
+
+
+def test_a_run_that_cannot_start_leaves_no_log_to_refuse_the_next_time(tmp_path):
+    log = tmp_path / "never.jsonl"
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--record", log, "--port", taken.getsockname()[1])
+    assert done.returncode == 1, done.stderr
+    assert not log.exists() and not os.path.exists(str(log) + ".idx")
+
+
+def test_run_appends_to_an_existing_log_when_asked(foo_bar_log, tmp_path):
+    log = tmp_path / "twice.jsonl"
+    for _ in range(2):
+        assert cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--no-serve", "--record", log,
+                   "--append").returncode == 0
+    runs = {json.loads(line)["run"] for line in log.read_text().splitlines()}
+    assert len(runs) == 2
+
+
 def test_run_records_under_runs_by_default_and_prints_the_path(tmp_path):
     done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), cwd=tmp_path)
     assert done.returncode == 0
@@ -127,6 +163,94 @@ def test_replay_exits_1_when_the_machine_ended_in_an_error(tmp_path):
     done = cli("replay", log)
     assert done.returncode == 1
     assert "InvalidUserCodeError" in done.stdout
+
+
+# What a terminal would obey: the window's title (OSC ... BEL), clear the screen (CSI 2J), go back
+# over the line (CR, BS), the 8-bit CSI (U+009B), DEL.
+ESCAPES = "\\x1b]0;pwned\\x07\\x1b[2J\\r\\x08\\u009b31m\\x7f"
+OBEYED = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f]")
+
+
+def test_replay_shows_the_control_characters_of_a_log_as_signs_never_raw(tmp_path):
+    script = tmp_path / "loud.py"
+    script.write_text("import fsm as smach\n"
+                      "def loud(ud):\n"
+                      "    smach.logwarn('message %s')\n"
+                      "    raise ValueError('error %s')\n"
+                      "sm = smach.StateMachine(['done'])\n"
+                      "with sm:\n"
+                      "    smach.StateMachine.add('LOUD', smach.CBState(loud, outcomes=['done']), {})\n"
+                      "sm.execute()\n" % (ESCAPES, ESCAPES))
+    log = tmp_path / "loud.jsonl"
+    assert cli("run", script, "--record", log).returncode == 1
+    done = cli("replay", log)
+    assert done.returncode == 1
+    assert not OBEYED.search(done.stdout + done.stderr), repr(OBEYED.findall(done.stdout + done.stderr))
+    assert "message \u241b]0;pwned\u2407\u241b[2J\u240d\u2408\ufffd31m\u2421" in done.stdout
+    assert "error \u241b]0;pwned" in done.stdout
+
+
+BUSY = """
+import fsm
+sm = fsm.StateMachine(["done"])
+n = [0]
+def tick(ud):
+    n[0] += 1
+    ud.text = "x" * 200
+    return "stop" if n[0] >= 3000 else "go"
+with sm:
+    fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["text"]), {"go": "B", "stop": "done"})
+    fsm.StateMachine.add("B", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["text"]), {"go": "A", "stop": "done"})
+sm.execute()
+"""
+
+
+@pytest.fixture
+def full_disk(tmp_path):
+    """A folder on a real file system of 64 KiB (a tmpfs: mounting one needs root), which a run fills."""
+    folder = tmp_path / "small"
+    folder.mkdir()
+    if subprocess.run(["mount", "-t", "tmpfs", "-o", "size=64k", "tmpfs", str(folder)], capture_output=True).returncode:
+        pytest.skip("mounting a small tmpfs needs root")
+    yield folder
+    subprocess.run(["umount", str(folder)], check=True)
+
+
+def test_a_run_whose_disk_fills_says_it_once_and_exits_1_keeping_the_events_before(full_disk, tmp_path):
+    script = tmp_path / "busy.py"
+    script.write_text(BUSY)
+    log = full_disk / "busy.jsonl"
+    done = cli("run", script, "--no-serve", "--record", log)
+    assert done.returncode == 1, done.stderr
+    assert "Traceback" not in done.stderr and done.stderr.count("could not write") == 1, done.stderr
+    assert "No space left on device" in done.stderr
+    replayed = cli("replay", log, "--json")
+    assert json.loads(replayed.stdout)["events"] > 100
+
+
+def test_an_import_whose_disk_fills_leaves_no_file_and_exits_2_saying_why(full_disk, tmp_path):
+    script = tmp_path / "busy.py"
+    script.write_text(BUSY)
+    log, mcap = tmp_path / "busy.jsonl", tmp_path / "busy.mcap"
+    assert cli("run", script, "--no-serve", "--record", log).returncode == 0
+    assert cli("export", log, "--mcap", mcap).returncode == 0
+    done = cli("import", mcap, "-o", full_disk / "busy.jsonl")
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "%s not written: No space left on device" % (full_disk / "busy.jsonl") in done.stderr
+    assert os.listdir(full_disk) == []
+
+
+@pytest.mark.parametrize("option", ["--html", "--mcap"])
+def test_an_export_whose_disk_fills_leaves_no_file_and_exits_2_saying_why(option, full_disk, tmp_path):
+    script = tmp_path / "busy.py"
+    script.write_text(BUSY)
+    log = tmp_path / "busy.jsonl"
+    assert cli("run", script, "--no-serve", "--record", log).returncode == 0
+    out = full_disk / "busy.out"
+    done = cli("export", log, option, out)
+    assert done.returncode == 2 and "Traceback" not in done.stderr, done.stderr
+    assert "%s not written: No space left on device" % out in done.stderr
+    assert os.listdir(full_disk) == []
 
 
 def test_replay_of_a_missing_file_is_a_one_line_error_with_exit_2(tmp_path):
@@ -310,6 +434,9 @@ def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_lo
     (["demo", "--headless", "--host", "0.0.0.0"], "--host has no meaning with --headless"),
     (["demo", "--headless", "--zenoh-token", "T"], "--zenoh-token needs --zenoh ROBOT"),
     (["serve", "--zenoh-scouting"], "--zenoh-scouting needs --zenoh"),
+    (["serve", "--foxglove-origin", "null"], "--foxglove-origin needs --foxglove PORT"),
+    (["run", "SCRIPT", "--append"], "--append needs --record"),
+    (["run", "SCRIPT", "--no-serve", "--foxglove-host", "robot.local"], "--foxglove-host needs --foxglove PORT"),
     (["replay", "LOG", "--speed", "2"], "--speed needs --serve"),
     (["replay", "LOG", "--token", "t"], "--token needs --serve"),
     (["replay", "LOG", "--serve", "--follow"], "--follow has no meaning with --serve"),

@@ -16,6 +16,7 @@ import socket
 import subprocess
 import sys
 import threading
+import time
 
 import fsm
 import pytest
@@ -27,6 +28,12 @@ from server.cli.foxglove_bridge import start_foxglove
 from server.http_server import ServerThread
 
 SUBPROTOCOL = "foxglove.sdk.v1"
+
+
+def foxglove_args(host: str = "127.0.0.1", **options) -> argparse.Namespace:
+    """The command line's options of ``--foxglove 0`` (``foxglove_origin``, ``foxglove_host``: lists)."""
+    return argparse.Namespace(**{"host": host, "foxglove": 0, "foxglove_origin": None, "foxglove_host": None,
+                                 **options})
 
 
 async def watch(port: int, topic: str, started: threading.Event, want: int) -> tuple[dict, list[dict]]:
@@ -57,7 +64,7 @@ def test_a_foxglove_client_sees_the_channels_and_the_active_state_change():
     try:
         sm = two_state_loop(20)
         srv.hub.add_local(sm, name="loop")
-        live = start_foxglove(argparse.Namespace(host="127.0.0.1", foxglove=0), srv.hub)
+        live = start_foxglove(foxglove_args(), srv.hub)
         started = threading.Event()
         runner = threading.Thread(target=lambda: started.wait(10) and sm.execute(), daemon=True)
         runner.start()
@@ -89,7 +96,7 @@ def test_the_foxglove_server_listens_on_the_loopback_only_whatever_host_says():
         pytest.skip("this computer has no address but the loopback")
     srv = ServerThread().start()
     try:
-        live = start_foxglove(argparse.Namespace(host="0.0.0.0", foxglove=0), srv.hub)
+        live = start_foxglove(foxglove_args(host="0.0.0.0"), srv.hub)
         try:
             with pytest.raises(ConnectionRefusedError):
                 socket.create_connection((address, live.port), timeout=5).close()
@@ -119,7 +126,8 @@ async def first_messages(port: int, topic: str, want: int) -> list[dict]:
 
 def foxglove_port_of(command: list[str], timeout: float = 30.0) -> tuple[subprocess.Popen, int]:
     """``fsmscope COMMAND`` in a real process, and the port of the Foxglove server it says it serves
-    (AssertionError with what it said when it says none within ``timeout`` seconds)."""
+    (AssertionError with what it said when it says none within ``timeout`` seconds). The process's
+    ``said``: the lines of its stderr up to that one; ``more``: a queue of the next ones."""
     proc = subprocess.Popen([sys.executable, "-m", "server.cli", *command], cwd=ROOT, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, text=True, start_new_session=True,
                             env=dict(os.environ, PYTHONPATH=ROOT))
@@ -131,6 +139,7 @@ def foxglove_port_of(command: list[str], timeout: float = 30.0) -> tuple[subproc
             said.append(lines.get(timeout=timeout))
             found = re.search(r"Foxglove WebSocket at ws://127\.0\.0\.1:(\d+)", said[-1])
             if found:
+                proc.said, proc.more = said, lines
                 return proc, int(found.group(1))
     except queue.Empty:
         os.killpg(proc.pid, signal.SIGKILL)
@@ -163,7 +172,7 @@ def states_seen(command: list[str], topic: str) -> set[str]:
     finally:
         os.killpg(proc.pid, signal.SIGTERM)
         proc.wait(20)
-    return {s["active"] for s in states}
+    return {s["active"] for s in states} - {""}  # "": idle, between two runs of the looping demo
 
 
 def test_a_script_run_without_a_dashboard_serves_foxglove_its_active_states(tmp_path):
@@ -197,3 +206,47 @@ def test_a_client_offering_only_the_older_foxglove_websocket_v1_is_refused():
     finally:
         live.stop()
     assert refused.value.response.status_code == 400
+
+
+def handshake(port: int, host: str, origin: str | None = None) -> str:
+    """The status line that the Foxglove server answers a raw websocket handshake with."""
+    head = ("GET / HTTP/1.1\r\nHost: %s\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+            "Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n"
+            "Sec-WebSocket-Protocol: %s\r\n" % (host, SUBPROTOCOL))
+    if origin is not None:
+        head += "Origin: %s\r\n" % origin
+    with socket.create_connection(("127.0.0.1", port), timeout=10) as s:
+        s.sendall((head + "\r\n").encode())
+        return s.makefile("rb").readline().decode().strip()
+
+
+def test_a_handshake_naming_another_host_is_refused_and_the_loopback_s_names_are_answered():
+    from interop.foxglove_live import FoxgloveLive
+
+    live = FoxgloveLive(port=0)
+    try:
+        assert handshake(live.port, "evil.example:%d" % live.port).startswith("HTTP/1.1 403")
+        for name in ("127.0.0.1:%d" % live.port, "localhost:%d" % live.port, "[::1]:%d" % live.port, "localhost:9"):
+            assert handshake(live.port, name).startswith("HTTP/1.1 101"), name
+    finally:
+        live.stop()
+
+
+def test_refused_handshakes_are_said_once_and_the_start_up_line_says_who_may_connect(tmp_path):
+    script = tmp_path / "looping.py"
+    script.write_text(LOOPING)
+    proc, port = foxglove_port_of(["run", str(script), "--no-serve", "--foxglove", "0", "--foxglove-origin",
+                                   "http://tools.internal:8080", "--record", str(tmp_path / "r.jsonl")])
+    try:
+        for i in range(200):
+            assert handshake(port, "127.0.0.1", origin="https://evil.example").startswith("HTTP/1.1 403")
+            assert handshake(port, "evil.example").startswith("HTTP/1.1 403")
+        assert handshake(port, "127.0.0.1", origin="http://tools.internal:8080").startswith("HTTP/1.1 101")
+    finally:
+        os.killpg(proc.pid, signal.SIGTERM)
+        proc.wait(20)
+    time.sleep(0.2)  # the reader of its stderr takes the last lines
+    said = list(proc.more.queue)
+    assert sum("Foxglove connection was refused" in line for line in said) == 1, said
+    assert len(said) < 5, said
+    assert "https://app.foxglove.dev, http://tools.internal:8080 may connect" in proc.said[-1]

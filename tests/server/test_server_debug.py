@@ -67,6 +67,17 @@ def test_code_in_a_condition_is_refused_with_its_column_and_the_set_is_unchanged
     assert http.get("/api/machines/loop/breakpoints").json()["breakpoints"][0]["when"] == "n > 1000000000"
 
 
+@pytest.mark.parametrize("when", [None, "", "   ", "\t\n"])
+def test_a_blank_condition_is_no_condition_whatever_its_spaces(looping, when):
+    http, _ = looping
+    response = http.put("/api/machines/loop/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/A", "when": when}]})
+    assert response.status_code == 200, response.text
+    assert http.get("/api/machines/loop/breakpoints").json()["breakpoints"] == [
+        {"state": "/SM_ROOT/A", "at": "before", "outcome": None, "when": None}]
+    http.put("/api/machines/loop/breakpoints", json={"breakpoints": []})
+    http.post("/api/machines/loop/resume")
+
+
 @pytest.mark.parametrize("spec, words", [
     ({"state": "/SM_ROOT/NOPE"}, "no state at '/SM_ROOT/NOPE'"),
     ({"state": "/SM_ROOT/A", "at": "after", "outcome": "nope"}, "'nope' is not an outcome of /SM_ROOT/A"),

@@ -29,6 +29,7 @@ from .fanout import Fanout, Observer
 from .feed import Feed
 from .history import History, LogHistory
 from .origin import Origin
+from .read_cache import Answers
 from .state_stats import StateStats
 from .timeline import TimelineIndex
 
@@ -66,6 +67,7 @@ class MachineEntry:
         self.past = History(self.feed, log)  # the ring's recent past, and a recording when it has one
         self.controls: Controls = controls if controls is not None else uncontrolled(name, origin.source)
         self.stats = StateStats(name)  # its states' statistics, counted when asked (server/state_stats.py)
+        self.answers = Answers()  # its reads' answers until it has a new event (server/read_cache.py)
         self.local: LocalMachine | None = None  # a machine of this process (add_local)
         self._structure_id: int | None = None
         self._structure_hash = ""

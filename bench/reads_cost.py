@@ -12,7 +12,10 @@ six clients seeking at once (each the status at a random seq, the history around
 back to back). A client is a process of its own: one keep-alive connection, which asks again as soon as
 it is answered, whatever the answer (a 429 too: it does not wait the Retry-After it is told, as a script
 that ignores it would not). The rates are counted afterwards in the recording, over each window; medians
-of the rounds. The machine's RSS is read before the first window and at the end of each.
+of the rounds. Each row also says the CPU of the machine's thread and of the server's (the process's
+other threads: what the reads cost, wherever the cores are shared), in % of a core, and the process's
+RSS (read before the first window and at the end of each). This 2-core computer is shared: the control
+row says what any busy process costs the machine here.
 
     .venv/bin/python bench/reads_cost.py [--rounds 3] [--seconds 5]
 """
@@ -34,6 +37,8 @@ from typing import Callable
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
+from live_rewind import thread_cpu  # noqa: E402  (the CPU of the machine's thread)
+from demo_cpu import cpu_seconds  # noqa: E402  (of the whole process)
 from table import print_table, verdict  # noqa: E402
 from timetravel_browser import served  # noqa: E402  (``fsmscope ...`` in its own process, its address)
 
@@ -164,9 +169,11 @@ class Window:
         if clients is not None:
             clients.__enter__()
             time.sleep(WARM_UP)
-        self.t0 = time.time()
+        machine, process, self.t0 = thread_cpu(pid), cpu_seconds(pid), time.time()
         time.sleep(seconds)
         self.t1 = time.time()
+        self.machine_cpu = (thread_cpu(pid) - machine) / (self.t1 - self.t0)
+        self.server_cpu = (cpu_seconds(pid) - process) / (self.t1 - self.t0) - self.machine_cpu
         self.rss = rss_mb(pid)
         if clients is not None:
             clients.__exit__()
@@ -211,7 +218,9 @@ def rows_of(windows: list[Window], rss_before: float) -> list[tuple[str, str, st
     for condition, kind, _ in CONDITIONS:
         mine = [w for w in windows if w.condition == condition]
         rate = statistics.median(w.rate for w in mine)
-        detail = "; RSS %.0f MiB (%.0f before)" % (max(w.rss for w in mine), rss_before)
+        detail = "; CPU %% of a core: machine %.0f, server %.1f; RSS %.0f MiB (%.0f before)" % (
+            statistics.median(w.machine_cpu for w in mine) * 100, statistics.median(w.server_cpu for w in mine) * 100,
+            max(w.rss for w in mine), rss_before)
         if kind not in (None, "burn"):
             latencies = sorted(x for w in mine for x in w.clients.latencies)
             statuses: dict[int, int] = {}

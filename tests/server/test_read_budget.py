@@ -20,7 +20,7 @@ from smach_support import counting_machine
 TIGHT = dict(rate=0.001, burst=0.01, hold=0.1)
 READS = ["/api/machines/m/summary", "/api/machines/m/status?seq=5", "/api/machines/m/history?limit=10",
          "/api/machines/m/timeline", "/api/machines/m/graph.svg", "/api/machines/m/structure", "/api/machines",
-         "/api/overview", "/api/machines/m/status"]
+         "/api/overview", "/api/machines/m/status", "/api/machines/m/breakpoints", "/api/scene", "/api/session"]
 ENOUGH = 500  # reads a client asks at most before its budget must be spent
 
 

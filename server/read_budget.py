@@ -70,12 +70,10 @@ class Meter:
 class ReadBudget:
     """The buckets of every client (on the loop: not thread-safe)."""
 
-    def __init__(self, rate: float = RATE, burst: float = BURST, hold: float = HOLD,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+    def __init__(self, rate: float = RATE, burst: float = BURST, hold: float = HOLD) -> None:
         self.rate = rate
         self.burst = burst
         self.hold = hold
-        self.clock = clock
         self._buckets: dict[Hashable, _Bucket] = {}
 
     def keys(self, address: str, role: str, page: str | None) -> tuple[Hashable, Hashable]:
@@ -84,11 +82,11 @@ class ReadBudget:
 
     def wait(self, keys: tuple[Hashable, Hashable]) -> float:
         """Seconds until every bucket of ``keys`` has paid its debt (0: now)."""
-        now = self.clock()
+        now = time.monotonic()
         return max(0.0, *(-self._level(key, limit, now) / limit[1] for key, limit in zip(keys, self._limits())))
 
     def charge(self, keys: tuple[Hashable, Hashable], seconds: float) -> None:
-        now = self.clock()
+        now = time.monotonic()
         for key, limit in zip(keys, self._limits()):
             self._buckets[key] = _Bucket(self._level(key, limit, now) - seconds, now, *limit)
         if len(self._buckets) > MAX_CLIENTS:

@@ -20,7 +20,7 @@ from fsm.logfiles.summary import Summary
 from .history import HistoryView
 
 CATCH_UP = 100_000  # events read for one question at most
-CATCH_UP_SECONDS = 0.01  # of this thread's CPU time read for one question, about (looked at every LOOK events)
+CATCH_UP_SECONDS = 0.005  # of this thread's CPU time read for one question, about (looked at every LOOK events)
 LOOK = 256
 
 

@@ -39,7 +39,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     ``show_pose``: what draws a pose's fields in that view (None: back to live), for POST /api/scene/pose;
     ``viewer_token``: a second token that may watch and not control (server/auth.py); ``deadman``: what a
     machine does when its operator's page goes silent (server/lease.py; default: pause after 3 s); ``reads``: what
-    each client's reads may cost the server (server/read_budget.py; default: 2.5 % of a core)."""
+    each client's reads may cost the server (server/read_budget.py; default: 2 % of a core)."""
     leases = LeaseControl(hub, Leases(deadman or Deadman()))
 
     @contextlib.asynccontextmanager

@@ -27,7 +27,7 @@ from typing import Any, Callable, Hashable, TypeVar
 
 from fastapi.concurrency import run_in_threadpool
 
-RATE = 0.025  # s of the server's work per second a client may use: 2.5 % of one core (a page: 1 to 2 %)
+RATE = 0.02  # s of the server's work per second a client may use: 2 % of one core (a page: about 1.3 %)
 BURST = 0.25  # s it may use at once (a page opening: the graph, the timeline, a history page)
 REQUEST_COST = 0.001  # s charged per read besides its measured work (uvicorn's, FastAPI's)
 HOLD = 1.0  # s a read over budget waits, to be answered (debt repaid by then) or refused (429)

@@ -96,10 +96,12 @@ class MachineEntry:
             self.feed.replace_sink(self.timeline.add, timeline.add)
             self.timeline = timeline
         self.feed.reset(status)
+        self.answers = Answers()  # seqs may begin again: no answer of the old epoch may be taken for a new one
 
     def read_past_from(self, log: LogHistory) -> None:
         """Its history is read from ``log`` alone from now on (a replay, loaded whole from it)."""
         self.past = History(None, log)
+        self.answers = Answers()
 
 
 class Hub:

@@ -101,11 +101,12 @@ async def summary(request: Request, hub: HubDep, entry: Machine, meter: ReadMete
     hub.fanout.flush()
     view = meter.run(entry.past.view)
     span = meter.run(view.span)
-    key = ("summary", path, id(entry.past), entry.feed.status.run, span["first_seq"], span["last_seq"])
-    found = entry.answers.get(key)
+    key = ("summary", path, span["first_seq"], span["last_seq"])
+    answers = entry.answers  # the epoch's (a restart meanwhile starts a new one)
+    found = answers.get(key)
     if found is None:
         data = await meter.in_thread(entry.stats.answer, view, root, path)
         found = meter.run(lambda: cached(dumps(data)))
         if data["complete"]:  # else the next question counts on
-            entry.answers.put(key, found)
+            answers.put(key, found)
     return found.response(request)

@@ -41,12 +41,13 @@ async def timeline(request: Request, entry: Machine, hub: HubDep, meter: ReadMet
     index = entry.timeline
     view = meter.run(entry.past.view)
     last = index.last
-    key = ("timeline", since_t, until_t, buckets, id(index), last and last["seq"], meter.run(view.span)["first_seq"])
-    found = entry.answers.get(key)
+    key = ("timeline", since_t, until_t, buckets, last and last["seq"], meter.run(view.span)["first_seq"])
+    answers = entry.answers  # the epoch's (a restart meanwhile starts a new one)
+    found = answers.get(key)
     if found is None:
         answer = await meter.in_thread(_answer, index, view, since_t, until_t, buckets)
         found = meter.run(lambda: cached(dumps(answer)))
-        entry.answers.put(key, found)
+        answers.put(key, found)
     return found.response(request)
 
 

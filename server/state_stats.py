@@ -21,7 +21,7 @@ from .history import HistoryView
 
 CATCH_UP = 100_000  # events read for one question at most
 CATCH_UP_SECONDS = 0.005  # of this thread's CPU time read for one question, about (looked at every LOOK events)
-LOOK = 256
+LOOK = 256  # events counted between two looks at the time spent
 
 
 class StateStats:

@@ -25,6 +25,7 @@ from .lease import Deadman, Leases
 from .lease_control import LeaseControl
 from .middleware import SecurityMiddleware
 from .overview import Overview
+from .read_budget import ReadBudget
 from .routes import control, debug, history, ingest, lease, machines, overview, pages, scene, stream, timeline
 from .settings import Settings
 from .static_files import static_dir
@@ -33,11 +34,12 @@ from .static_files import static_dir
 def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int | None = None,
                title: str = "fsmscope", scene_url: str | None = None,
                show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None,
-               deadman: Deadman | None = None) -> FastAPI:
+               deadman: Deadman | None = None, reads: ReadBudget | None = None) -> FastAPI:
     """The dashboard's app; ``scene_url``: a 3D view served beside it (the sim demo's viser), or None;
     ``show_pose``: what draws a pose's fields in that view (None: back to live), for POST /api/scene/pose;
     ``viewer_token``: a second token that may watch and not control (server/auth.py); ``deadman``: what a
-    machine does when its operator's page goes silent (server/lease.py; default: pause after 3 s)."""
+    machine does when its operator's page goes silent (server/lease.py; default: pause after 3 s); ``reads``: what
+    each client's reads may cost the server (server/read_budget.py; default: 2 % of a core)."""
     leases = LeaseControl(hub, Leases(deadman or Deadman()))
 
     @contextlib.asynccontextmanager
@@ -54,6 +56,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     app.state.hub = hub
     app.state.leases = leases
     app.state.overview = Overview(hub)
+    app.state.reads = reads or ReadBudget()
     app.state.show_pose = show_pose
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(RequestValidationError, _validation_error)

@@ -13,6 +13,7 @@ from typing import Any, Callable
 from .auth import check_bind, new_token
 from .hub import Hub
 from .lease import Deadman
+from .read_budget import ReadBudget
 
 
 def ws_implementation() -> str:
@@ -65,7 +66,7 @@ class ServerThread:
     def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
                  log_level: str = "warning", scene_url: str | None = None,
                  show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None,
-                 deadman: Deadman | None = None) -> None:
+                 deadman: Deadman | None = None, reads: ReadBudget | None = None) -> None:
         from .app import create_app
         import uvicorn
 
@@ -78,7 +79,7 @@ class ServerThread:
         self.port = self.sock.getsockname()[1]
         self.app = create_app(self.hub, self.token, host=host, port=self.port, scene_url=scene_url,
                               show_pose=show_pose, viewer_token=self.viewer_token if self.token else None,
-                              deadman=deadman)
+                              deadman=deadman, reads=reads)
         self.server = uvicorn.Server(uvicorn_config(self.app, log_level))
         self._thread: threading.Thread | None = None
 

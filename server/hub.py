@@ -29,6 +29,7 @@ from .fanout import Fanout, Observer
 from .feed import Feed
 from .history import History, LogHistory
 from .origin import Origin
+from .read_cache import Answers
 from .state_stats import StateStats
 from .timeline import TimelineIndex
 
@@ -66,6 +67,7 @@ class MachineEntry:
         self.past = History(self.feed, log)  # the ring's recent past, and a recording when it has one
         self.controls: Controls = controls if controls is not None else uncontrolled(name, origin.source)
         self.stats = StateStats(name)  # its states' statistics, counted when asked (server/state_stats.py)
+        self.answers = Answers()  # its reads' answers until it has a new event (server/read_cache.py)
         self.local: LocalMachine | None = None  # a machine of this process (add_local)
         self._structure_id: int | None = None
         self._structure_hash = ""
@@ -94,10 +96,12 @@ class MachineEntry:
             self.feed.replace_sink(self.timeline.add, timeline.add)
             self.timeline = timeline
         self.feed.reset(status)
+        self.answers = Answers()  # seqs may begin again: no answer of the old epoch may be taken for a new one
 
     def read_past_from(self, log: LogHistory) -> None:
         """Its history is read from ``log`` alone from now on (a replay, loaded whole from it)."""
         self.past = History(None, log)
+        self.answers = Answers()
 
 
 class Hub:

@@ -4,19 +4,24 @@ GET /api/machines/{name}/summary (docs/api.md, "State statistics").
 
 Nothing is paid per event: a machine's ``Summary`` is fed only when somebody asks, with the events
 since the last question (from memory, or the recording for older ones), at most ``CATCH_UP`` per
-question, so a page polling every second reads only the last second's events, and a first question
-about a long recording answers at once with what it has counted so far (``counted`` says how far).
+question and ``CATCH_UP_SECONDS`` of work, so a page polling every second reads only the last second's
+events, a first question about a long recording answers at once with what it has counted so far
+(``counted`` says how far), and a machine faster than counting is never slowed down by it: its
+summary says how far behind it is.
 """
 
 from __future__ import annotations
 
 import threading
+import time
 
 from fsm.logfiles.summary import Summary
 
 from .history import HistoryView
 
 CATCH_UP = 100_000  # events read for one question at most
+CATCH_UP_SECONDS = 0.005  # of this thread's CPU time read for one question, about (looked at every LOOK events)
+LOOK = 256  # events counted between two looks at the time spent
 
 
 class StateStats:
@@ -57,6 +62,10 @@ class StateStats:
             self.first = since
             if structure is not None:  # its events from the first counted on may hold no structure event
                 self.summary.structures.add(self.machine, structure)
-        for event in view.events(since, until):
+        deadline = time.thread_time() + CATCH_UP_SECONDS
+        for counted, event in enumerate(view.events(since, until), 1):
             self.summary.add(event)
+            if counted % LOOK == 0 and time.thread_time() > deadline:
+                self.upto = event["seq"]
+                return
         self.upto = until

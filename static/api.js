@@ -18,6 +18,12 @@ export const PAGE_ID = Array.from(crypto.getRandomValues(new Uint8Array(12)), (b
 /** Headers of every request: the token's and this page's id. */
 const pageHeaders = () => ({ ...authHeaders(), "X-Fsmscope-Page": PAGE_ID });
 
+/** A read refused for its client's budget of the server's time (429, docs/api.md "Read budget") is asked
+ * again after the Retry-After it was told (at most RETRY_MAX_S), up to RETRIES times: the page is slowed,
+ * never shown an error for it. */
+const RETRIES = 3;
+const RETRY_MAX_S = 30;
+
 async function request(method, url, body, accept = "json") {
   const init = { method, credentials: "omit", cache: "no-store", headers: pageHeaders() };
   if (body !== undefined) {
@@ -25,10 +31,15 @@ async function request(method, url, body, accept = "json") {
     init.body = JSON.stringify(body);
   }
   let response;
-  try {
-    response = await fetch(url, init);
-  } catch (err) {
-    throw new ApiError(0, "server unreachable");
+  for (let attempt = 0; ; attempt++) {
+    try {
+      response = await fetch(url, init);
+    } catch (err) {
+      throw new ApiError(0, "server unreachable");
+    }
+    if (response.status !== 429 || method !== "GET" || attempt >= RETRIES) break;
+    const wait = Math.min(Number(response.headers.get("Retry-After")) || 1, RETRY_MAX_S);
+    await new Promise((resolve) => setTimeout(resolve, wait * 1000));
   }
   if (!response.ok) {
     let detail = response.statusText || "request failed";

@@ -36,6 +36,7 @@ class _Machine:
         self.visits: dict[str, int] = {}
         self.durations: dict[str, array] = {}  # seconds of each visit that ended (an array: a long run has millions)
         self.last_outcome: dict[str, str] = {}  # state path -> the outcome it last returned
+        self.times: dict[str, tuple[int, dict]] = {}  # state path -> (visits timed, ``time_in``'s answer for them)
         self.entered: dict[str, dict[str, float | None]] = {}  # container path -> {label: entered at}
         self.transitions: dict[tuple[str, str, str, str | None], int] = {}
         self.errors: list[dict] = []
@@ -90,11 +91,19 @@ class _Machine:
 
     def state(self, state: str) -> dict:
         """The statistics of one state path: visits, seconds (total, median, max, last), last outcome."""
+        return {"visits": self.visits.get(state, 0), "time": self.time_in(state),
+                "last_outcome": self.last_outcome.get(state)}
+
+    def time_in(self, state: str) -> dict:
+        """Seconds in ``state``: total, median, max, last; computed once per number of visits timed (a
+        server asks again and again, and the median sorts them all)."""
         times = self.durations.get(state, ())
-        return {"visits": self.visits.get(state, 0), "time": {
-            "total": sum(times), "median": statistics.median(times) if times else None,
-            "max": max(times) if times else None, "last": times[-1] if times else None},
-            "last_outcome": self.last_outcome.get(state)}
+        known = self.times.get(state)
+        if known is None or known[0] != len(times):
+            known = self.times[state] = (len(times), {
+                "total": sum(times), "median": statistics.median(times) if times else None,
+                "max": max(times) if times else None, "last": times[-1] if times else None})
+        return dict(known[1])
 
     def sync(self, path: str, active: list[str], t: float | None) -> None:
         current = self.entered.get(path, {})

@@ -12,7 +12,7 @@ from fastapi.concurrency import run_in_threadpool
 
 from ..control_models import Breakpoints, ForceRequest, SeqResponse, StepRequest
 from ..models import BreakpointSpec
-from .deps import AUTH, ERRORS, LEASED, OPERATOR, ClientAddress, MachineControls
+from .deps import AUTH, ERRORS, LEASED, OPERATOR, READ, READ_ERRORS, ClientAddress, MachineControls
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["debug"])
 
@@ -47,7 +47,7 @@ async def force(controls: MachineControls, client: ClientAddress, body: ForceReq
     return SeqResponse(seq=await run_in_threadpool(controls.force, body.state, body.outcome, client))
 
 
-@router.get("/api/machines/{name}/breakpoints", response_model=Breakpoints)
+@router.get("/api/machines/{name}/breakpoints", response_model=Breakpoints, dependencies=READ, responses=READ_ERRORS)
 async def breakpoints(controls: MachineControls) -> Breakpoints:
     listed = await run_in_threadpool(controls.breakpoints)  # a remote machine's wait for its publisher's answer
     return Breakpoints(breakpoints=[BreakpointSpec(**bp) for bp in listed])

@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import asyncio
 import re
-from typing import Annotated
+from typing import Annotated, AsyncIterator
 
 from fastapi import Depends, HTTPException, Path, Request, WebSocket
 from starlette.requests import HTTPConnection
@@ -16,6 +17,7 @@ from ..hub import Hub, MachineEntry
 from ..lease import LeaseHeld
 from ..lease_control import LeaseControl
 from ..middleware import deny_handshake
+from ..read_budget import REQUEST_COST, Meter, ReadBudget, retry_after
 
 ERRORS = {code: {"model": models.Error} for code in (400, 401, 403, 404, 409, 413, 422)}
 NAME = Path(min_length=1, max_length=200, description="machine name")
@@ -79,6 +81,33 @@ def client_address(request: Request, role: Annotated[str, Depends(require_token)
 
 
 ClientAddress = Annotated[str, Depends(client_address)]
+
+
+async def read_budget(request: Request, role: Annotated[str, Depends(require_token)],
+                      page: Page) -> AsyncIterator[Meter]:
+    """Dependency of every read: its client's budget of the server's time (server/read_budget.py). A read
+    over it waits for it, or is answered 429 with Retry-After; the read's cost is charged when it is done."""
+    budget: ReadBudget = request.app.state.reads
+    keys = budget.keys(request.client.host if request.client else "", role, page)
+    wait = budget.wait(keys)
+    if wait > budget.hold:
+        await asyncio.sleep(budget.hold)
+        budget.charge(keys, REQUEST_COST)
+        retry = retry_after(budget.wait(keys))
+        raise HTTPException(429, budget.refusal(retry), headers={"Retry-After": str(retry)})
+    if wait > 0:
+        await asyncio.sleep(wait)
+    meter = Meter()
+    try:
+        yield meter
+    finally:
+        budget.charge(keys, REQUEST_COST + meter.seconds)
+
+
+ReadMeter = Annotated[Meter, Depends(read_budget)]
+READ = [Depends(read_budget)]
+READ_ERRORS = {**ERRORS, 429: {"model": models.Error, "description": "this client's budget of the server's time "
+                                "for reads is spent: retry after the seconds Retry-After says"}}
 
 
 def get_leases(connection: HTTPConnection) -> LeaseControl:

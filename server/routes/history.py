@@ -2,7 +2,9 @@
 statistics of its states counted over them (server/state_stats.py).
 
 Both read what machine threads handed over first (``Fanout.flush``), copy what memory holds on the
-loop (``History.view``) and do the rest, file reads included, in the thread pool.
+loop (``History.view``) and do the rest, file reads included, in the thread pool; what each read
+costs is measured and charged to its client's budget (server/read_budget.py). The summary, asked
+every second by a page, is kept until the machine has a new event (server/read_cache.py).
 """
 
 from __future__ import annotations
@@ -10,8 +12,7 @@ from __future__ import annotations
 import math
 from typing import Annotated, Any, Callable, Literal, Optional
 
-from fastapi import APIRouter, HTTPException, Query
-from fastapi.concurrency import run_in_threadpool
+from fastapi import APIRouter, HTTPException, Query, Request
 from fastapi.responses import Response
 
 from fsm.observation.encoding import dumps
@@ -20,11 +21,13 @@ from fsm.observation.schema import KINDS, MAX_PATH
 
 from .. import models
 from ..history import DEFAULT_LIMIT, MAX_LIMIT, HistoryView
-from .deps import AUTH, ERRORS, HubDep, Machine
+from ..read_budget import Meter
+from ..read_cache import cached
+from .deps import AUTH, READ_ERRORS, HubDep, Machine, ReadMeter
 
 router = APIRouter(dependencies=AUTH, tags=["machines"])
 
-PAST_ERRORS = {**ERRORS,
+PAST_ERRORS = {**READ_ERRORS,
                410: {"model": models.Error, "description": "older than the history kept (the message says how far "
                      "back it reaches)"},
                416: {"model": models.Error, "description": "beyond the machine's last event"}}
@@ -33,16 +36,16 @@ T_EXAMPLES = {"an instant": {"value": 1700000000.5, "description": "the status a
                              "before this time"}}
 
 
-async def answer(hub: HubDep, entry: Machine, question: Callable[[HistoryView], Any]) -> Any:
-    """``question(view)`` on a view of the machine's history, in the thread pool (what it refuses is
-    answered as any ``Refused`` is, by the app)."""
+async def answer(hub: HubDep, entry: Machine, meter: Meter, question: Callable[[HistoryView], Any]) -> Any:
+    """``question(view)`` on a view of the machine's history, in the thread pool, measured (what it refuses
+    is answered as any ``Refused`` is, by the app)."""
     hub.fanout.flush()
-    view = entry.past.view()
-    return await run_in_threadpool(question, view)
+    view = meter.run(entry.past.view)
+    return await meter.in_thread(question, view)
 
 
 @router.get("/api/machines/{name}/status", response_model=models.MachineStatus, responses=PAST_ERRORS)
-async def status(hub: HubDep, entry: Machine,
+async def status(hub: HubDep, entry: Machine, meter: ReadMeter,
                  seq: Annotated[Optional[int], Query(ge=0, description="the status right after this event",
                                                      openapi_examples=SEQ_EXAMPLES)] = None,
                  t: Annotated[Optional[float], Query(description="the status after the last event at or before "
@@ -54,14 +57,14 @@ async def status(hub: HubDep, entry: Machine,
     if t is not None and not math.isfinite(t):
         raise HTTPException(422, "t must be a finite number of seconds, not %s" % t)
     if seq is None and t is None:
-        data = entry.feed.status_dict()
+        data = meter.run(entry.feed.status_dict)
     else:
-        data = await answer(hub, entry, lambda view: view.status_at(seq, t))
-    return Response(dumps(data), media_type="application/json")
+        data = await answer(hub, entry, meter, lambda view: view.status_at(seq, t))
+    return Response(meter.run(dumps, data), media_type="application/json")
 
 
 @router.get("/api/machines/{name}/history", response_model=models.HistoryPage, responses=PAST_ERRORS)
-async def history(hub: HubDep, entry: Machine,
+async def history(hub: HubDep, entry: Machine, meter: ReadMeter,
                   since: Annotated[Optional[int], Query(ge=0, description="from this seq (default: the oldest "
                                                         "kept)")] = None,
                   until: Annotated[Optional[int], Query(ge=0, description="to this seq (default: the last)")] = None,
@@ -81,18 +84,29 @@ async def history(hub: HubDep, entry: Machine,
         unknown = sorted(wanted - set(KINDS))
         if unknown:
             raise HTTPException(422, "kinds: %r is not an event kind (%s)" % (unknown[0][:50], ", ".join(KINDS)))
-    page = await answer(hub, entry, lambda view: view.page(since, until, limit, wanted, path, order))
-    return Response(page.to_json(), media_type="application/json")
+    page = await answer(hub, entry, meter, lambda view: view.page(since, until, limit, wanted, path, order))
+    return Response(meter.run(page.to_json), media_type="application/json")
 
 
 @router.get("/api/machines/{name}/summary", response_model=models.StateSummary, responses=PAST_ERRORS)
-async def summary(hub: HubDep, entry: Machine,
+async def summary(request: Request, hub: HubDep, entry: Machine, meter: ReadMeter,
                   path: Annotated[Optional[str], Query(max_length=MAX_PATH, description="only this state or "
                                                        "container (default: every state visited)")] = None,
                   ) -> Response:
-    """Per-state statistics (visits, time in state, last outcome), as ``fsmscope replay`` counts them."""
+    """Per-state statistics (visits, time in state, last outcome), as ``fsmscope replay`` counts them; the
+    same answer (and ETag) until the machine has a new event."""
     root = entry.feed.status.structure
     if path is not None and structure.node_at(root, path) is None:
         raise HTTPException(404, "machine %r has no state %r" % (entry.name, path[:200]))
-    data = await answer(hub, entry, lambda view: entry.stats.answer(view, root, path))
-    return Response(dumps(data), media_type="application/json")
+    hub.fanout.flush()
+    view = meter.run(entry.past.view)
+    span = meter.run(view.span)
+    key = ("summary", path, span["first_seq"], span["last_seq"])
+    answers = entry.answers  # the epoch's (a restart meanwhile starts a new one)
+    found = answers.get(key)
+    if found is None:
+        data = await meter.in_thread(entry.stats.answer, view, root, path)
+        found = meter.run(lambda: cached(dumps(data)))
+        if data["complete"]:  # else the next question counts on
+            answers.put(key, found)
+    return found.response(request)

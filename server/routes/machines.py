@@ -1,22 +1,22 @@
-"""What the dashboard reads about machines: the list, a machine's structure, its graph (its status: routes/history.py)."""
+"""What the dashboard reads about machines: the list, a machine's structure, its graph (its status: routes/history.py).
+Each read is charged to its client's budget (server/read_budget.py)."""
 
 from __future__ import annotations
 
 from typing import Annotated, Any
 
 from fastapi import APIRouter, HTTPException, Query
-from fastapi.concurrency import run_in_threadpool
 from fastapi.responses import Response
 
 from fsm.observation.structure import node_at
 
 from .. import graph, models
-from .deps import AUTH, ERRORS, HubDep, Machine
+from .deps import AUTH, READ, READ_ERRORS, HubDep, Machine, ReadMeter
 
 router = APIRouter(dependencies=AUTH, tags=["machines"])
 
 
-@router.get("/api/machines", response_model=list[models.MachineInfo], responses=ERRORS)
+@router.get("/api/machines", response_model=list[models.MachineInfo], responses=READ_ERRORS, dependencies=READ)
 async def list_machines(hub: HubDep) -> list[dict]:
     out = []
     for entry in hub.machines():
@@ -32,7 +32,8 @@ async def list_machines(hub: HubDep) -> list[dict]:
     return out
 
 
-@router.get("/api/machines/{name}/structure", response_model=models.StructureNode, responses=ERRORS)
+@router.get("/api/machines/{name}/structure", response_model=models.StructureNode, responses=READ_ERRORS,
+            dependencies=READ)
 async def structure(entry: Machine) -> Any:
     root = entry.feed.status.structure
     if root is None:
@@ -41,8 +42,8 @@ async def structure(entry: Machine) -> Any:
 
 
 @router.get("/api/machines/{name}/graph.svg",
-            responses={**ERRORS, 200: {"content": {"image/svg+xml": {}}, "description": "the graph"}})
-async def graph_svg(entry: Machine, expand: Annotated[list[str] | None, Query(max_length=200)] = None) -> Response:
+            responses={**READ_ERRORS, 200: {"content": {"image/svg+xml": {}}, "description": "the graph"}})
+async def graph_svg(entry: Machine, meter: ReadMeter, expand: Annotated[list[str] | None, Query(max_length=200)] = None) -> Response:
     root = entry.feed.status.structure
     if root is None:
         raise HTTPException(404, "machine %r has no structure yet" % entry.name)
@@ -51,5 +52,5 @@ async def graph_svg(entry: Machine, expand: Annotated[list[str] | None, Query(ma
         node = node_at(root, path)
         if node is None or not node.get("container"):
             raise HTTPException(404, "no container at %r" % path)
-    svg = await run_in_threadpool(graph.render, root, key, expand, n_states)
+    svg = await meter.in_thread(graph.render, root, key, expand, n_states)
     return Response(svg, media_type="image/svg+xml", headers={"Cache-Control": "no-cache"})

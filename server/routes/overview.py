@@ -19,14 +19,14 @@ from fsm.observation.encoding import dumps
 
 from .. import models
 from ..auth import websocket_subprotocol
-from .deps import AUTH, ERRORS, refused
+from .deps import AUTH, READ, READ_ERRORS, refused
 
 router = APIRouter(tags=["machines"])
 
 EVERY = 0.5  # seconds between two looks at the tiles
 
 
-@router.get("/api/overview", response_model=list[models.Tile], dependencies=AUTH, responses=ERRORS)
+@router.get("/api/overview", response_model=list[models.Tile], dependencies=AUTH + READ, responses=READ_ERRORS)
 async def overview(request: Request) -> list[dict]:
     return request.app.state.overview.tiles()
 

@@ -14,7 +14,7 @@ from fastapi.responses import FileResponse, HTMLResponse, Response
 from .. import models
 from ..auth import require_token
 from ..static_files import static_dir
-from .deps import AUTH, ERRORS
+from .deps import AUTH, READ, READ_ERRORS
 
 router = APIRouter()
 
@@ -58,12 +58,13 @@ async def health() -> models.Health:
     return models.Health(ok=True)
 
 
-@router.get("/api/scene", response_model=models.Scene, dependencies=AUTH, responses=ERRORS, tags=["meta"])
+@router.get("/api/scene", response_model=models.Scene, dependencies=AUTH + READ, responses=READ_ERRORS,
+            tags=["meta"])
 async def scene(request: Request) -> models.Scene:
     return models.Scene(url=request.app.state.settings.scene_url)
 
 
-@router.get("/api/session", response_model=models.Session, responses=ERRORS, tags=["meta"],
+@router.get("/api/session", response_model=models.Session, dependencies=READ, responses=READ_ERRORS, tags=["meta"],
             description="What the request's token lets it do: the page hides the controls of a viewer.")
 async def session(role: Annotated[str, Depends(require_token)]) -> models.Session:
     return models.Session(role=role)

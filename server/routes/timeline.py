@@ -1,26 +1,30 @@
-"""A machine's timeline (server/timeline.py): its span, bands, ticks and transition seqs, at a zoom."""
+"""A machine's timeline (server/timeline.py): its span, bands, ticks and transition seqs, at a zoom.
+
+A page asks it again every second while a live run grows: the answer is kept until the machine has a
+new event (server/read_cache.py), and what it costs is charged to the client's budget (server/read_budget.py).
+"""
 
 from __future__ import annotations
 
 import math
 from typing import Annotated, Any, Optional
 
-from fastapi import APIRouter, HTTPException, Query
-from fastapi.concurrency import run_in_threadpool
+from fastapi import APIRouter, HTTPException, Query, Request
 from fastapi.responses import Response
 
 from fsm.observation.encoding import dumps
 
 from .. import models
-from .deps import AUTH, ERRORS, HubDep, Machine
+from ..read_cache import cached
+from .deps import AUTH, READ_ERRORS, HubDep, Machine, ReadMeter
 
 router = APIRouter(dependencies=AUTH, tags=["machines"])
 
 MAX_BUCKETS = 10_000
 
 
-@router.get("/api/machines/{name}/timeline", response_model=models.Timeline, responses=ERRORS)
-async def timeline(entry: Machine, hub: HubDep,
+@router.get("/api/machines/{name}/timeline", response_model=models.Timeline, responses=READ_ERRORS)
+async def timeline(request: Request, entry: Machine, hub: HubDep, meter: ReadMeter,
                    since_t: Annotated[Optional[float], Query(description="from this time (default: the first "
                                                              "event's)")] = None,
                    until_t: Annotated[Optional[float], Query(description="to this time (default: the last "
@@ -34,8 +38,17 @@ async def timeline(entry: Machine, hub: HubDep,
     if since_t is not None and until_t is not None and since_t > until_t:
         raise HTTPException(422, "since_t (%r) is after until_t (%r)" % (since_t, until_t))
     hub.fanout.flush()
-    answer = await run_in_threadpool(_answer, entry.timeline, entry.past.view(), since_t, until_t, buckets)
-    return Response(dumps(answer), media_type="application/json")
+    index = entry.timeline
+    view = meter.run(entry.past.view)
+    last = index.last
+    key = ("timeline", since_t, until_t, buckets, last and last["seq"], meter.run(view.span)["first_seq"])
+    answers = entry.answers  # the epoch's (a restart meanwhile starts a new one)
+    found = answers.get(key)
+    if found is None:
+        answer = await meter.in_thread(_answer, index, view, since_t, until_t, buckets)
+        found = meter.run(lambda: cached(dumps(answer)))
+        answers.put(key, found)
+    return found.response(request)
 
 
 def _answer(index: Any, history: Any, since_t: float | None, until_t: float | None, buckets: int) -> dict:

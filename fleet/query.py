@@ -41,7 +41,7 @@ def reply(query: zenoh.Query, token: str | None, payload: bytes, nonce: str | No
     """The robot's answer to ``query``, with its proof over the query's nonce (its ``nonce`` parameter,
     unless given) when the robot has a token."""
     key = str(query.key_expr)
-    said = query.parameters.get("nonce") or "" if nonce is None else nonce
+    said = nonce if nonce is not None else query.parameters.get("nonce") or ""
     query.reply(query.key_expr, payload,
                 attachment=answer_proof(token, key, said, payload) if token else None)
 

@@ -16,6 +16,7 @@ A log is never written onto unless asked (``append``): a command refuses a file 
 
 from __future__ import annotations
 
+import itertools
 import os
 import runpy
 import signal
@@ -36,26 +37,29 @@ EXIT_NOT_RECORDED = 1  # the script ended well, but its log could not be written
 EXIT_CANNOT_RECORD = 2  # the log was refused (it exists) or cannot be opened: nothing ran
 
 
-def default_record_path(script: str, directory: str = "runs") -> str:
-    """``runs/<script>-<time>.jsonl``, or ``...-2.jsonl``, ``-3``... when a run of the same second has it."""
-    stem = "%s-%s" % (os.path.splitext(os.path.basename(script))[0], time.strftime("%Y%m%d-%H%M%S"))
-    path, n = os.path.join(directory, stem + ".jsonl"), 2
-    while os.path.exists(path):
-        path, n = os.path.join(directory, "%s-%d.jsonl" % (stem, n)), n + 1
-    return path
-
-
-def open_recorder(path: str, append: bool, command: str) -> Recorder | None:
-    """The recorder of ``path``, a new file unless ``append``; None, said on stderr as ``fsmscope
-    COMMAND``, when the file exists (and ``append`` is not given) or cannot be opened."""
+def open_recorder(path: str | None, append: bool, command: str, script: str) -> tuple[str, Recorder | None]:
+    """The log's path and its recorder: ``path``, a new file unless ``append``; None for it, ``runs/
+    <script>-<time>.jsonl`` (or ``-2``, ``-3``... when a run of the same second has it), opened
+    exclusively, so two processes started in the same second never write one file. The recorder is
+    None, said on stderr as ``fsmscope COMMAND``, when the file exists (and ``append`` is not given)
+    or cannot be opened."""
     try:
-        return Recorder(path, new=not append)
+        if path is not None:
+            return path, Recorder(path, new=not append)
+        stem = os.path.join("runs", "%s-%s" % (os.path.splitext(os.path.basename(script))[0],
+                                               time.strftime("%Y%m%d-%H%M%S")))
+        for n in itertools.count(1):
+            path = stem + ("-%d" % n if n > 1 else "") + ".jsonl"
+            try:
+                return path, Recorder(path, new=True)
+            except FileExistsError:  # another run of the same second took it
+                continue
     except FileExistsError:
         sys.stderr.write("fsmscope %s: %s exists already: --append adds to it, or record to another file\n"
                          % (command, path))
     except OSError as exc:
         sys.stderr.write("fsmscope %s: cannot record to %s: %s\n" % (command, path, exc.strerror or exc))
-    return None
+    return str(path), None
 
 
 @dataclass
@@ -80,7 +84,7 @@ class Runner:
 
     def __post_init__(self) -> None:
         self.stem = os.path.splitext(os.path.basename(self.script))[0]
-        self.record_path = self.record or default_record_path(self.script)
+        self.record_path = self.record or ""  # the default's name is found when the log is opened (prepare)
         self._lock = threading.Lock()
         self._restore_sigterm: Callable[[], None] = lambda: None
 
@@ -108,7 +112,7 @@ class Runner:
         if not os.path.isfile(os.path.abspath(self.script)):
             sys.stderr.write("fsmscope run: %s: no such file\n" % self.script)
             return 2
-        self.recorder = open_recorder(self.record_path, self.append, "run")
+        self.record_path, self.recorder = open_recorder(self.record, self.append, "run", self.script)
         return EXIT_CANNOT_RECORD if self.recorder is None else None
 
     def run(self) -> int:

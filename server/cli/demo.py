@@ -70,13 +70,12 @@ def main(args: argparse.Namespace) -> int:
     from sim.demo import SimDemo
     from sim.pose import PoseTap
 
-    from ..runner import EXIT_CANNOT_RECORD, EXIT_NOT_RECORDED, default_record_path, open_recorder
+    from ..runner import EXIT_CANNOT_RECORD, EXIT_NOT_RECORDED, open_recorder
 
     if not args.verbose:
         _quiet_loggers()
     robot = zenoh_robot(args, can_start=False)  # first: an endpoint Zenoh cannot use ends the command before it starts
-    record_path = args.record or default_record_path("demo")
-    recorder = open_recorder(record_path, args.append, "demo")
+    record_path, recorder = open_recorder(args.record, args.append, "demo", "demo")
     if recorder is None:
         if robot is not None:
             robot.close()

@@ -135,7 +135,7 @@ def read_events(path: str | os.PathLike, on_problem: Callable[[Problem], None] |
 
 
 def writer_active(path: str | os.PathLike) -> bool:
-    """True while a Recorder holds the log open (it keeps a shared flock on it)."""
+    """True while a Recorder holds the log open (it keeps an exclusive flock on it)."""
     if fcntl is None:
         return True
     try:

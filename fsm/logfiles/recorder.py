@@ -11,8 +11,10 @@ state rebuilt by ``fsm.observation.status.Status``) and a line ``{"machine", "se
 ``<path>.idx`` sidecar, so a reader can rebuild the state at any event without reading the
 log from its start (``fsm.logfiles.log_reader.seek``).
 
-While open, the recorder holds a shared ``flock`` on the log: a reader that can take an
-exclusive lock knows that nobody writes the file any more (``fsm.logfiles.log_reader.follow``).
+While open, the recorder holds an exclusive ``flock`` on the log: a second recorder of it (another
+process's ``--append``) is refused with ``LogBusy`` rather than interleave two runs' seqs in one
+file, and a reader that can take the lock knows that nobody writes the file any more
+(``fsm.logfiles.log_reader.follow``).
 
 A write that fails (a full disk) ends the recording there, said once on stderr: the log holds
 the events before it (a last line cut short is skipped by readers), later events are dropped,
@@ -50,6 +52,10 @@ else:
         return encoding.dumps(obj) + b"\n"
 
 
+class LogBusy(OSError):
+    """The log is open in another recorder (of this process or another): it is not written twice."""
+
+
 def index_path(path: str | os.PathLike) -> str:
     return os.fspath(path) + ".idx"
 
@@ -72,7 +78,11 @@ class Recorder:
         self._new = new
         self._file = open(self.path, "xb" if new else "ab")
         if fcntl is not None:
-            fcntl.flock(self._file.fileno(), fcntl.LOCK_SH)
+            try:
+                fcntl.flock(self._file.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except BlockingIOError:
+                self._file.close()
+                raise LogBusy("%s is being written by another recorder" % self.path) from None
         self._index = open(index_path(self.path), "wb" if new else "ab") if index else None
         self._taken = self._file.seek(0, os.SEEK_END)  # bytes handed to the writer so far
         self._lock = threading.Lock()  # guards the buffers and statuses

@@ -12,7 +12,7 @@ import fsm
 import pytest
 from fsm.observation.encoding import loads
 from fsm.logfiles.log_reader import read_events, read_index, writer_active
-from fsm.logfiles.recorder import Recorder
+from fsm.logfiles.recorder import LogBusy, Recorder
 from fsm.observation.status import Status, rebuild
 
 from recording_support import two_state_loop, ROOT, load_example, record
@@ -174,3 +174,13 @@ def test_a_script_that_exits_without_closing_its_recorder_has_every_event_writte
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     assert len(_lines(path)) == int(done.stderr.rsplit("events=", 1)[1]) > 100
+
+
+def test_a_log_another_recorder_is_writing_is_not_opened_again(tmp_path):
+    path = tmp_path / "run.jsonl"
+    writing = Recorder(path, new=True)
+    try:
+        with pytest.raises(LogBusy, match="being written by another recorder"):
+            Recorder(path)  # an --append of another process, as it meets the log
+    finally:
+        writing.close()

@@ -47,6 +47,26 @@ class _Machine:
         self.run_start: float | None = None  # when the open run started
         self.run_end: float | None = None  # when the last run ended
         self.idle = 0.0  # between runs
+        self.run: str | None = None  # the run of the last event
+        self.left: set[str] = set()  # runs whose events were followed by another run's
+        self.last_seq: int | None = None
+        self.interleaved = 0  # events that came back to a run already left, or did not follow their run's seq
+
+    def written(self, run: str | None, seq: int | None) -> None:
+        """An event of ``run`` numbered ``seq``: one that comes back to a run the log had left, or does
+        not follow its run's last seq, was written by a second writer at once (two processes
+        recording into one file): its runs' events interleave."""
+        if run is None:  # before the machine's first run: no run to follow
+            pass
+        elif run != self.run:
+            if run in self.left:
+                self.interleaved += 1
+            if self.run is not None:
+                self.left.add(self.run)
+            self.run = run
+        elif seq is not None and self.last_seq is not None and seq <= self.last_seq:
+            self.interleaved += 1
+        self.last_seq = seq
 
     def start_run(self, t: float | None) -> None:
         if self.run_start is not None:  # the log never ended the run before: it ends at its last event
@@ -137,6 +157,7 @@ class Summary:
         if m is None:
             m = self.machines[name] = _Machine(name)
         m.events += 1
+        m.written(event.get("run"), event.get("seq"))
         t = event.get("t")
         if m.first_t is None:
             m.first_t = t
@@ -193,11 +214,12 @@ class Summary:
         return self.machines.get(machine, _Machine(machine)).state(state)
 
     def exit_code(self) -> int:
-        """0: every machine finished with an outcome; 1: one ended in an error, or never finished;
+        """0: every machine finished with an outcome; 1: one ended in an error, never finished, or its
+        events were written by two processes at once;
         2: not one event (the log is empty or unreadable, which is not a run that failed)."""
         if not self.machines:
             return 2
-        return 0 if all(m.status == FINISHED for m in self.machines.values()) else 1
+        return 0 if all(m.status == FINISHED and not m.interleaved for m in self.machines.values()) else 1
 
     def to_dict(self) -> dict:
         machines = {}
@@ -210,7 +232,8 @@ class Summary:
                 "states": states,
                 "transitions": [{"path": p, "from": f, "outcome": o, "to": to, "count": c}
                                 for (p, f, o, to), c in m.transitions.items()],
-                "errors": m.errors, "preempts": dict(m.preempts), "feedback": m.feedback, "controls": m.controls}
+                "errors": m.errors, "preempts": dict(m.preempts), "feedback": m.feedback, "controls": m.controls,
+                "interleaved": m.interleaved}
         return {"events": self.events, "machines": machines, "exit_code": self.exit_code(),
                 "problems": [{"line": p.line, "message": p.message} for p in self.problems]}
 
@@ -242,6 +265,10 @@ class Summary:
                 for tr in sorted(m["transitions"], key=lambda tr: (tr["path"], -tr["count"])):
                     to = "(done)" if tr["to"] is None else tr["to"]
                     out.append("    %s: %s --%s--> %s  x%d" % (tr["path"], tr["from"], tr["outcome"], to, tr["count"]))
+            if m["interleaved"]:
+                out.append("  written by two processes at once: %d event%s out of their run's order (two runs' "
+                           "events interleave in this log; each process should record to a file of its own)"
+                           % (m["interleaved"], "" if m["interleaved"] == 1 else "s"))
             if m["preempts"]["requested"] or m["preempts"]["serviced"]:
                 out.append("  preempts: %(requested)d requested, %(serviced)d serviced" % m["preempts"])
             if m["errors"]:

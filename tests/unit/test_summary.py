@@ -104,3 +104,30 @@ def test_the_text_summary_gives_the_running_time_and_the_idle_time_between_runs(
     text = summarize(_two_runs_100_s_apart()).format()
     assert "machine m: finished with outcome 'done' after 8.000 s running (2 runs, 9 events, " \
            "100.000 s idle between runs)" in text
+
+
+def _two_writers(tmp_path):
+    """The lines of two processes' runs of one machine "m" (each recorded to its own file)."""
+    logs = []
+    for i in range(2):
+        record(machine(["done"], [("A", Out("go"), {"go": "B"}), ("B", Out("done"), {"done": "done"})]),
+               tmp_path / ("w%d.jsonl" % i))
+        logs.append((tmp_path / ("w%d.jsonl" % i)).read_text().splitlines())
+    return logs
+
+
+def test_a_log_two_processes_wrote_at_once_is_said_and_not_clean(tmp_path):
+    first, second = _two_writers(tmp_path)
+    mixed = tmp_path / "mixed.jsonl"
+    mixed.write_text("".join(a + "\n" + b + "\n" for a, b in zip(first, second)))
+    summary = summarize(read_events(str(mixed)))
+    assert summary.machines["m"].interleaved > 0 and summary.exit_code() == 1
+    assert "written by two processes at once" in summary.format()
+
+
+def test_a_log_appended_to_by_a_second_process_is_not_two_writers(tmp_path):
+    first, second = _two_writers(tmp_path)
+    appended = tmp_path / "appended.jsonl"
+    appended.write_text("\n".join(first + second) + "\n")
+    summary = summarize(read_events(str(appended)))
+    assert summary.machines["m"].interleaved == 0 and summary.exit_code() == 0

@@ -69,7 +69,8 @@ class _Machine:
     """What the robot keeps of one machine: its pending batch, the batches put, its Zenoh entities."""
 
     def __init__(self, session: zenoh.Session, robot: str, name: str, controls: RobotControls,
-                 shared: dict[str, tuple[Any, Callable[[], Status]]], wake: threading.Event) -> None:
+                 shared: dict[str, tuple[Any, Callable[[], Status]]], wake: threading.Event,
+                 first: dict | None = None) -> None:
         self.name = name
         self.status = Status(name)
         self.shared = shared  # the robot's: a host's Status read instead of this one (ZenohRobot.follow)
@@ -90,6 +91,8 @@ class _Machine:
         self.state = session.declare_queryable(keys.state_key(robot, name), self._state)
         self.history = session.declare_queryable(keys.history_key(robot, name), self._history)
         self.control = controls.declare(session, keys.control_key(robot, name), name)
+        if first is not None:
+            self.keep(first)
         self.token = session.liveliness().declare_token(keys.machine_key(robot, name))  # last: all is there
 
     def keep(self, event: dict) -> None:
@@ -210,26 +213,31 @@ class ZenohRobot:
         except KeyError:
             if self._stop.is_set():  # closed: the machine runs on, unpublished
                 return
-            machine = self._declare(event["machine"])
+            machine = self._declare(event["machine"], event)
+            if machine is None:  # declared with this event kept first
+                return
         machine.keep(event)
 
-    def _declare(self, name: str) -> _Machine:
-        """A machine's first event: its Zenoh entities (machines of other threads may come at once)."""
+    def _declare(self, name: str, first: dict | None = None) -> _Machine | None:
+        """A machine's Zenoh entities (machines of other threads may come at once), with its ``first``
+        event kept before its liveliness token is declared: a dashboard that joins at once finds that
+        event in the state it asks. None when it kept ``first``, else the machine."""
         with self._declaring:
-            if name not in self._machines:
-                key = keys.chunk(name, "machine")  # a name Zenoh cannot take fails here, in the machine's thread
-                made = threading.Thread(target=self._declare_in_thread, args=(name, key), daemon=True)
-                made.start()
-                made.join()
-            return self._machines[name]
+            if name in self._machines:
+                return self._machines[name]
+            key = keys.chunk(name, "machine")  # a name Zenoh cannot take fails here, in the machine's thread
+            made = threading.Thread(target=self._declare_in_thread, args=(name, key, first), daemon=True)
+            made.start()
+            made.join()
+            return None if first is not None else self._machines[name]
 
-    def _declare_in_thread(self, name: str, key: str) -> None:
+    def _declare_in_thread(self, name: str, key: str, first: dict | None) -> None:
         """In a daemon thread: Zenoh runs a queryable's callbacks in a Python thread that is a daemon
         only when the declaring thread is one, and a thread that is not would keep the process from
         ending (Python waits for those before the exit hook that closes the robot). ``close`` waits
         for those threads to end: one still in Zenoh's code when the interpreter ends aborts it."""
         before = set(threading.enumerate())
-        self._machines[name] = _Machine(self.session, self.robot, key, self.controls, self._shared, self._wake)
+        self._machines[name] = _Machine(self.session, self.robot, key, self.controls, self._shared, self._wake, first)
         self._callback_threads += [thread for thread in threading.enumerate()
                                    if thread not in before and thread is not threading.current_thread()]
 
@@ -252,7 +260,9 @@ class ZenohRobot:
         the machine one call per event (bench/fleet_cost.py)."""
         self.take_controls(handle)
         self._shared[machine] = (lock, current)
-        return self._declare(machine).take
+        declared = self._declare(machine)
+        assert declared is not None
+        return declared.take
 
     def flush(self) -> None:
         """Put every pending batch now (a control's answer comes after the events it caused)."""

@@ -260,9 +260,8 @@ class ZenohRobot:
         the machine one call per event (bench/fleet_cost.py)."""
         self.take_controls(handle)
         self._shared[machine] = (lock, current)
-        declared = self._declare(machine)
-        assert declared is not None
-        return declared.take
+        self._declare(machine)
+        return self._machines[machine].take
 
     def flush(self) -> None:
         """Put every pending batch now (a control's answer comes after the events it caused)."""

@@ -4,12 +4,13 @@
 // and its panels by the renderer (renderer.js) at a pace. What the user does goes to the store or to
 // the server.
 
+import { AccessForm } from "./access.js";
 import { api } from "./api.js";
 import { Audit } from "./audit.js";
 import { showBadge } from "./badge.js";
 import { Breadcrumb } from "./breadcrumb.js";
 import { Breakpoints, debugMarks } from "./breakpoints.js";
-import { LinkFollower, readLink } from "./deeplink.js";
+import { LinkFollower, linkTo, onLinkChanged, readLink } from "./deeplink.js";
 import { Controls } from "./controls.js";
 import { DebugBar } from "./debugger.js";
 import { Depth } from "./depth.js";
@@ -92,11 +93,14 @@ const timeline = new Timeline($("timeline"), {
   speed: (x) => playhead.setSpeed(x),
   step: (direction, path) => playhead.step(direction, path),
   live: () => playhead.live(),
+  copyLink: () => copyLink(),
 });
 const scene = new SceneView($("scene-pane"), document.querySelector("main.layout"), api.scenePose);
 const notices = new RunNotices(store);
+const access = new AccessForm($("access"));
 const machines = new Machines($("machine-picker"), store, {
   open: (name) => openMachine(name),
+  refused: (yes) => access.show(yes),
   polled: () => {
     if (store.state.machines.online && !scene.url) api.scene().then((s) => scene.show(s && s.url)).catch(() => {});
   },
@@ -123,7 +127,7 @@ const feed = new Feed(store, api, {
 const renderer = new Renderer(store, [render, renderPanels]);
 const drawing = new MachineDrawing(store, api, { graph, depth, tree, userdata }, () => renderer.queue());
 const timelineLoader = new TimelineLoader(store, api, timeline);
-const address = new LinkFollower(store);
+const address = new LinkFollower(store, () => playhead.seeking);
 
 // ---------------------------------------------------------------- what each change of the store draws
 
@@ -173,6 +177,36 @@ function openMachine(name) {
   userdata.show(null);
   log.reset();
   feed.open(name);
+}
+
+/** Show what a hash the user changed in the tab names: another machine, another instant, or live. */
+function followLink({ machine, seq }) {
+  const { name, machines: { list } } = store.state;
+  if (machine === null) return;
+  if (machine !== name) {
+    if (list.some((m) => m.name === machine)) openMachine(machine); // at the link's seq
+    else store.say(`No machine named ${machine} here`, "warn");
+  } else if (seq !== null) {
+    if (!playhead.past || playhead.seq !== seq) playhead.seek({ seq });
+  } else if (playhead.past && !playhead.replay) {
+    playhead.live();
+  }
+}
+
+/** Copy the address of the machine at the instant shown, and say who it opens for: it holds no token. */
+async function copyLink() {
+  const { name, instant } = store.state;
+  if (name === null) return;
+  const seq = instant.past ? instant.status.last_seq : null;
+  const link = linkTo(name, seq);
+  const what = `${name} ${seq === null ? "live" : "at event " + seq}`;
+  const who = "in this browser; anyone else also needs this dashboard's address with its token (the viewer's, to only watch)";
+  try {
+    await navigator.clipboard.writeText(link);
+    store.say(`Link copied: it opens ${what} ${who}`, "ok");
+  } catch (err) { // no clipboard (a page not served from this computer over plain http): the link to copy by hand
+    store.say(`Copy this link, which opens ${what} ${who}: ${link}`, "ok");
+  }
 }
 
 /** The history of `key` of container `path` in the current run, beside the userdata. */
@@ -290,6 +324,7 @@ setInterval(() => { // the badge's rate and latency move on with time
 }, 500);
 setInterval(() => notices.checkOverdue(), 500);
 
+onLinkChanged(followLink);
 exposeToConsole(store);
 showNotice($("notice"), $("banner"), store.state);
 machines.poll();

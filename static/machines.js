@@ -47,7 +47,8 @@ export function showRunState(pill, s, entry) {
 
 /** The /api/machines list, polled into the store (store.js), and the picker that opens one of them. */
 export class Machines {
-  /** @param {object} handlers {open(name): show that machine, polled(): after each poll, answered or not} */
+  /** @param {object} handlers {open(name): show that machine, polled(): after each poll, answered or not,
+   * refused(yes): whether the server refused this page's token} */
   constructor(picker, store, handlers) {
     this.picker = picker;
     this.store = store;
@@ -59,13 +60,15 @@ export class Machines {
     try {
       const list = await api.machines();
       this.store.setBanner("");
+      this.handlers.refused(false);
       this.store.setMachines(Array.isArray(list) ? list : [], true);
       this.checkEndings();
       this._pick();
     } catch (err) {
       const unauthorized = err instanceof ApiError && err.status === 401;
-      this.store.setBanner(unauthorized ? "Not authorized: open the address the server printed (the one with ?token=...)." : "");
+      this.store.setBanner(unauthorized ? "Not authorized: this browser holds no valid token for this dashboard." : "");
       this.store.setMachines(null, false);
+      this.handlers.refused(unauthorized);
     } finally {
       this.handlers.polled();
       setTimeout(() => this.poll(), POLL_MS);

@@ -1,4 +1,4 @@
-// The timeline's toolbar and keyboard: play / pause, speed, step, start / end, zoom, "back to live",
+// The timeline's toolbar and keyboard: play / pause, speed, step, start / end, zoom, "back to live", "copy link",
 // and the line that says which instant is shown ("live" or "viewing the past: ..."). Buttons and keys
 // call the same Timeline actions; the keys work anywhere in the page but in a text field.
 
@@ -34,6 +34,7 @@ export class TimelineControls {
       status: h("span", { class: "tl-status" }),
       kept: h("span", { class: "tl-kept muted" }),
       live: button("back to live", "Back to the live machine (End)", "tl-live"),
+      copy: button("copy link", "Copy a link to this machine at the instant shown (it holds no token)", "tl-copy"),
       zoomOut: button("−", "Zoom out (-)"),
       zoomIn: button("+", "Zoom in (+)"),
       whole: button("whole run", "Show the whole run (double-click the timeline)"),
@@ -41,7 +42,7 @@ export class TimelineControls {
     const e = this.el;
     e.live.hidden = true;
     this.bar = h("div", { class: "toolbar tl-bar" }, h("span", { class: "title", text: "Timeline" }),
-      e.start, e.prev, e.play, e.next, e.end, e.speed, e.status, e.kept, e.live, h("span", { class: "spacer" }),
+      e.start, e.prev, e.play, e.next, e.end, e.speed, e.status, e.kept, e.live, e.copy, h("span", { class: "spacer" }),
       e.zoomOut, e.zoomIn, e.whole);
     e.play.addEventListener("click", () => tl.togglePlay());
     e.speed.addEventListener("change", () => tl.call("speed", Number(e.speed.value)));
@@ -50,6 +51,7 @@ export class TimelineControls {
     e.start.addEventListener("click", () => tl.toStart());
     e.end.addEventListener("click", () => tl.toEnd());
     e.live.addEventListener("click", () => tl.call("live"));
+    e.copy.addEventListener("click", () => tl.call("copyLink"));
     e.zoomIn.addEventListener("click", () => tl.zoom(1 / ZOOM_STEP));
     e.zoomOut.addEventListener("click", () => tl.zoom(ZOOM_STEP));
     e.whole.addEventListener("click", () => tl.wholeRun());

@@ -35,7 +35,7 @@ export class Playhead {
     this.ahead = []; // events after the instant, fetched while playing
     this.exhausted = false; // no events after `ahead` (the end of what the server has)
     this._target = null; // the newest seek asked for
-    this._busy = false;
+    this._busy = null; // the seek answering, while one is
     this._generation = (this._generation || 0) + 1; // answers for an earlier machine or seek are dropped
     this._windowTimer = null;
     if (name === null) return;
@@ -59,6 +59,11 @@ export class Playhead {
     return this.store.state.instant.replay;
   }
 
+  /** Whether an instant asked for has not been shown yet. */
+  get seeking() {
+    return this._target !== null || this._busy !== null;
+  }
+
   get seq() {
     return this.status ? this.status.last_seq : null;
   }
@@ -80,6 +85,7 @@ export class Playhead {
     this.pause();
     this._generation += 1;
     this._target = null;
+    this._busy = null; // a seek still answering belongs to the generation just left: the next one runs anew
     if (this.replay) {
       this._last();
       return;
@@ -138,7 +144,8 @@ export class Playhead {
   // ---------------------------------------------------------------- seeking
 
   async _run() {
-    this._busy = true;
+    const run = {};
+    this._busy = run;
     const generation = this._generation;
     try {
       while (this._target !== null && generation === this._generation) {
@@ -152,7 +159,7 @@ export class Playhead {
     } catch (err) {
       if (generation === this._generation) this.failed(err);
     } finally {
-      if (generation === this._generation) this._busy = false;
+      if (this._busy === run) this._busy = null;
     }
   }
 

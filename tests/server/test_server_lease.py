@@ -1,5 +1,6 @@
 """The operator lease and the deadman against a real uvicorn (docs/debugging.md, "One operator at a time")."""
 
+import contextlib
 import threading
 
 import httpx
@@ -12,6 +13,7 @@ from server_support import client
 from server_support import looping_machine
 
 DEADMAN_AFTER = 1.5
+PATIENT_DEADMAN = 120.0
 
 
 def page(srv, page_id):
@@ -21,10 +23,10 @@ def page(srv, page_id):
     return http
 
 
-@pytest.fixture
-def served():
-    """The looping machine served as 'loop' (running) by a server whose deadman pauses after 1.5 s."""
-    srv = ServerThread(deadman=Deadman(DEADMAN_AFTER, "pause")).start()
+@contextlib.contextmanager
+def serving(deadman_after: float):
+    """The looping machine served as 'loop' (running) by a server whose deadman pauses after ``deadman_after`` s."""
+    srv = ServerThread(deadman=Deadman(deadman_after, "pause")).start()
     sm, stop = looping_machine()
     srv.hub.add_local(sm, name="loop")
     runner = threading.Thread(target=sm.execute, daemon=True)
@@ -38,6 +40,21 @@ def served():
         http.post("/api/machines/loop/resume")
         runner.join(5)
         srv.stop()
+
+
+@pytest.fixture
+def served():
+    """For the lease's own rules: a deadman far longer than any test, so a slow moment between two
+    requests never frees the lease a test is checking."""
+    with serving(PATIENT_DEADMAN) as served:
+        yield served
+
+
+@pytest.fixture
+def quick_deadman():
+    """For the deadman's rules: it pauses after DEADMAN_AFTER s."""
+    with serving(DEADMAN_AFTER) as served:
+        yield served
 
 
 def controls(srv, action=None):
@@ -109,8 +126,8 @@ def test_a_malformed_page_id_is_refused_with_a_message(served):
     assert answer.status_code == 422 and "X-Fsmscope-Page" in answer.json()["detail"]
 
 
-def test_a_silent_holder_pauses_the_machine_within_the_deadman_time(served):
-    srv, _ = served
+def test_a_silent_holder_pauses_the_machine_within_the_deadman_time(quick_deadman):
+    srv, _ = quick_deadman
     page(srv, "one").post("/api/machines/loop/lease")
     wait_for(lambda: controls(srv, "deadman"), timeout=DEADMAN_AFTER + 3)
     [deadman] = controls(srv, "deadman")
@@ -120,8 +137,8 @@ def test_a_silent_holder_pauses_the_machine_within_the_deadman_time(served):
     assert client(srv).get("/api/machines/loop/lease").json()["holder"] is None
 
 
-def test_a_beating_holder_keeps_the_lease(served):
-    srv, _ = served
+def test_a_beating_holder_keeps_the_lease(quick_deadman):
+    srv, _ = quick_deadman
     one = page(srv, "one")
     one.post("/api/machines/loop/lease")
     for _ in range(6):

@@ -8,6 +8,7 @@ import runpy
 import signal
 import subprocess
 import sys
+import threading
 
 import fsm
 from fsm.logfiles.recorder import Recorder
@@ -51,7 +52,10 @@ def replay_served(log, *args):
     """``fsmscope replay LOG --serve ARGS`` in a real process: yields (the address it printed, token
     included; the stderr lines before it); ended with Ctrl-C, as a user would, which exits 0."""
     proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve", *map(str, args)],
-                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True)
+                            cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env={**os.environ, "PYTHONFAULTHANDLER": "1"})  # SIGABRT: every thread's stack
+    later: list[str] = []
+    drain = None
     try:
         said = []
         for line in proc.stderr:
@@ -61,11 +65,22 @@ def replay_served(log, *args):
             said.append(line)
         else:
             raise AssertionError("fsmscope replay --serve printed no address: %r" % said)
+        # What it says after the address is read on, or a full pipe would stop it mid-line, Ctrl-C and all.
+        drain = threading.Thread(target=later.extend, args=(proc.stderr,), daemon=True)
+        drain.start()
         yield found.group(1), said
     finally:
         os.killpg(proc.pid, signal.SIGINT)
-        code = proc.wait(20)
-    assert code == 0, "fsmscope replay --serve exited %d on Ctrl-C" % code
+        try:
+            code = proc.wait(20)
+        except subprocess.TimeoutExpired:
+            proc.send_signal(signal.SIGABRT)
+            proc.wait(10)
+            if drain is not None:
+                drain.join(5)
+            raise AssertionError("fsmscope replay --serve did not exit within 20 s of Ctrl-C; its threads:\n%s"
+                                 % "".join(later)[-6000:]) from None
+    assert code == 0, "fsmscope replay --serve exited %d on Ctrl-C; it said: %s" % (code, "".join(later)[-2000:])
 
 
 def two_state_loop(n):

@@ -33,13 +33,14 @@ from .static_files import static_dir
 
 def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int | None = None,
                title: str = "fsmscope", scene_url: str | None = None,
-               show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None,
+               show_pose: Callable[[str, dict | None], None] | None = None, viewer_token: str | None = None,
                deadman: Deadman | None = None, reads: ReadBudget | None = None) -> FastAPI:
     """The dashboard's app; ``scene_url``: a 3D view served beside it (the sim demo's viser), or None;
-    ``show_pose``: what draws a pose's fields in that view (None: back to live), for POST /api/scene/pose;
-    ``viewer_token``: a second token that may watch and not control (server/auth.py); ``deadman``: what a
-    machine does when its operator's page goes silent (server/lease.py; default: pause after 3 s); ``reads``: what
-    each client's reads may cost the server (server/read_budget.py; default: 2 % of a core)."""
+    ``show_pose(view, pose)``: what draws a pose's fields in one page's view of it (None: back to live), for
+    POST /api/scene/pose; ``viewer_token``: a second token that may watch and not control (server/auth.py);
+    ``deadman``: what a machine does when its operator's page goes silent (server/lease.py; default: pause
+    after 3 s); ``reads``: what each client's reads may cost the server (server/read_budget.py; default: 2 %
+    of a core)."""
     leases = LeaseControl(hub, Leases(deadman or Deadman()))
 
     @contextlib.asynccontextmanager

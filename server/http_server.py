@@ -65,7 +65,7 @@ class ServerThread:
 
     def __init__(self, hub: Hub | None = None, host: str = "127.0.0.1", port: int = 0, token: str | None = None,
                  log_level: str = "warning", scene_url: str | None = None,
-                 show_pose: Callable[[dict | None], None] | None = None, viewer_token: str | None = None,
+                 show_pose: Callable[[str, dict | None], None] | None = None, viewer_token: str | None = None,
                  deadman: Deadman | None = None, reads: ReadBudget | None = None) -> None:
         from .app import create_app
         import uvicorn

@@ -36,18 +36,25 @@ class Scene(BaseModel):
     url: str | None = None
 
 
-class ScenePoseRequest(BaseModel):
-    """POST /api/scene/pose: a pose event's fields to show in the 3D view, or null for the live robot."""
-    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
-        {"pose": {"joints": {"j1": 0.0, "j2": 0.0309, "finger_left": 0.04},
-                  "bodies": {"cube": [0.4, 0.15, 0.42, 1.0, 0.0, 0.0, 0.0]}}}, {"pose": None}]})
+VIEW = "0f3c9a7e5b2d4c6f8a1e3b5d7c9f2a4e"  # an example of a page's view id (static/scene.js makes one per page)
 
+
+class ScenePoseRequest(BaseModel):
+    """POST /api/scene/pose: a pose event's fields to show in one page's 3D view, or null for the live robot."""
+    model_config = ConfigDict(extra="forbid", json_schema_extra={"examples": [
+        {"view": VIEW, "pose": {"joints": {"j1": 0.0, "j2": 0.0309, "finger_left": 0.04},
+                                "bodies": {"cube": [0.4, 0.15, 0.42, 1.0, 0.0, 0.0, 0.0]}}},
+        {"view": VIEW, "pose": None}]})
+
+    view: str = Field(pattern=r"^[A-Za-z0-9_-]{16,64}$",
+                      description="the page's own 3D view: the random id its frame of the view connected with "
+                                  "(ws://HOST:PORT/view/ID); only that view's browsers are shown the pose")
     pose: Optional[dict[str, JsonValue]] = Field(description="{joints: {name: position}, bodies?: {name: "
                                                  "[x, y, z, qw, qx, qy, qz]}} (docs/events.md, kind pose), or null")
 
 
 class ScenePoseShown(BaseModel):
-    live: bool = Field(description="the 3D view shows the live robot again (the request's pose was null)")
+    live: bool = Field(description="the page's 3D view shows the live robot again (the request's pose was null)")
 
 
 class ReplayInfo(BaseModel):

@@ -92,8 +92,8 @@ export const api = {
   timeline: (name, params) => request("GET", machine(name) + "/timeline" + query(params)),
   /** Each state's visits, time in state and last outcome, as `fsmscope replay` counts them ({path}: only that one). */
   summary: (name, path) => request("GET", machine(name) + "/summary" + query({ path })),
-  /** Show a recorded pose in the 3D view (null: back to the live arm). */
-  scenePose: (pose) => request("POST", "/api/scene/pose", { pose }),
+  /** Show a recorded pose in this page's own 3D view, `view` (static/scene.js; null: back to the live arm). */
+  scenePose: (view, pose) => request("POST", "/api/scene/pose", { view, pose }),
   graphSvg: (name, expand) => request("GET", machine(name) + "/graph.svg" + query({ expand }), undefined, "text"),
   anyOpenSet: true, // the server lays out any set of open containers (semantic zoom asks for them)
   preempt: (name, reason) => request("POST", machine(name) + "/preempt", { reason: reason || "" }),

@@ -132,6 +132,15 @@ def watching(browser, server, machine: str, ready: str | None = None):
         yield page
 
 
+def scene_client(scene, page) -> int:
+    """The viser client of ``page``'s 3D view (``scene``: the sim.scene.Scene it shows): the one that
+    connected with the view id in the address of the page's frame (static/scene.js)."""
+    view = page.eval_on_selector("#scene-pane iframe",
+                                 "f => new URL(new URL(f.src).searchParams.get('websocket')).pathname.split('/').pop()")
+    return wait_for(lambda: [c for c, v in scene.clients().items() if v == view], timeout=30,
+                    what="the page's frame to connect to viser")[0]
+
+
 def as_page(http: httpx.Client, page) -> httpx.Client:
     """``http`` sending the page's id: the operator lease (docs/debugging.md) is held by the page whose
     controls took it, so the test's own requests come from that page."""

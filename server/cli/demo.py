@@ -13,7 +13,7 @@ import argparse
 import signal
 import sys
 import threading
-from typing import Any
+from typing import Any, Callable
 
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
 from .serving import SERVER_OPTIONS, add_server_arguments, announce_viewer, foxglove_unused, given_of, start_server
@@ -61,12 +61,24 @@ def _print_episode(info: dict) -> None:
           "{attempts} attempt(s), {sim_time:.1f} s simulated, {wall_time:.2f} s wall)".format(**info), flush=True)
 
 
+def pose_events(rep: Any) -> Callable[[dict], bool]:
+    """What the pose tap gives each new pose to: a pose event of the machine's reporter ``rep``, on the
+    machine's own clock (declined until the machine has started: a log opens with its structure)."""
+    from fsm.observation import schema
+
+    def record_pose(fields: dict) -> bool:
+        if rep.run is None:
+            return False
+        rep.send(schema.build.pose, rep.root_path, fields["joints"], fields.get("bodies", schema.ABSENT))
+        return True
+    return record_pose
+
+
 def main(args: argparse.Namespace) -> int:
     """Physics, action servers, the task machine, its recording, and unless headless the dashboard
     with the 3D view; until the episodes are done, Ctrl-C or SIGTERM. Everything is undone on exit."""
     import fsm
     from fsm.control.handle import MachineHandle
-    from fsm.observation import schema
     from sim.demo import SimDemo
     from sim.pose import PoseTap
 
@@ -88,13 +100,7 @@ def main(args: argparse.Namespace) -> int:
     machine = demo.build_machine()
     rep = fsm.attach(machine, recorder, name=MACHINE_NAME)
 
-    def record_pose(fields: dict) -> bool:
-        if rep.run is None:  # not started yet: a log opens with the machine's structure
-            return False
-        rep.send(schema.build.pose, rep.root_path, fields["joints"], fields.get("bodies", schema.ABSENT))
-        return True
-
-    tap = PoseTap(demo.world, record_pose)
+    tap = PoseTap(demo.world, pose_events(rep))
     resume = threading.Event()
     hold = threading.Event()
     server = None

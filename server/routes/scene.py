@@ -1,7 +1,10 @@
-"""Show a recorded pose in the 3D view (the page looking back at an instant), or the live robot again.
+"""Show a recorded pose in one page's 3D view (that page looking back at an instant), or the live robot again.
 
-The server draws nothing itself: the composition root (server/cli/) gives the app a ``show_pose``
-callable when it serves a 3D view (the demo's ``Scene.show_pose``), so ``server`` never imports ``sim``.
+Looking back is a page's own business: the page names its own view (the random id its frame of the
+3D view connected with, static/scene.js), and only that view's browsers are shown the pose; every
+other page's view stays as it is. The server draws nothing itself: the composition root
+(server/cli/) gives the app a ``show_pose(view, pose)`` callable when it serves a 3D view (the
+demo's ``Scene.show_pose``), so ``server`` never imports ``sim``.
 """
 
 from __future__ import annotations
@@ -31,10 +34,10 @@ def pose_problem(pose: dict[str, Any]) -> str | None:
 
 
 @router.post("/api/scene/pose", response_model=models.ScenePoseShown,
-             description="Draw a pose in the 3D view instead of the live robot (null: the live robot again). "
-                         "404 when this server has no 3D view.")
+             description="Draw a pose in the page's own 3D view (`view`) instead of the live robot (null: the live "
+                         "robot again); no other page's view changes. 404 when this server has no 3D view.")
 async def show_pose(request: Request, body: models.ScenePoseRequest) -> models.ScenePoseShown:
-    show: Callable[[dict | None], None] | None = request.app.state.show_pose
+    show: Callable[[str, dict | None], None] | None = request.app.state.show_pose
     if show is None:
         raise HTTPException(404, "no 3D view")
     if body.pose is not None:
@@ -42,7 +45,7 @@ async def show_pose(request: Request, body: models.ScenePoseRequest) -> models.S
         if problem:
             raise HTTPException(422, problem)
     try:
-        await run_in_threadpool(show, body.pose)
+        await run_in_threadpool(show, body.view, body.pose)
     except ValueError as exc:  # a joint or body the scene's model does not have
         raise HTTPException(422, str(exc)) from exc
     return models.ScenePoseShown(live=body.pose is None)

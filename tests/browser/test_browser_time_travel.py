@@ -11,7 +11,7 @@ import urllib.parse
 
 import fsm
 import pytest
-from browser_support import served_page
+from browser_support import scene_client, served_page
 from fsm.logfiles.log_reader import read_events, seek
 from server.cli import replay
 from server.http_server import ServerThread
@@ -108,10 +108,12 @@ def test_the_arm_is_drawn_where_the_log_put_it_at_the_instant(browser, replayed,
     srv, scene = replayed
     carried = first_transition(events, "/SM_ROOT/TASK/PLACE")["seq"]  # TRANSPORT done: the cube in the air
     pose = [e for e in events if e["kind"] == "pose" and e["seq"] <= carried][-1]
-    page = open_at(browser, srv, carried)
+    page = open_page(browser, srv.url + "#m=" + MACHINE + "&seq=%d" % carried)  # its 3D view drawn
+    shown_at(page, carried)
     assert page.evaluate("window.fsmscope.status.pose.seq") == pose["seq"]
     cube = pose["bodies"]["cube"][:3]
-    wait_for(lambda: all(abs(a - b) < 1e-4 for a, b in zip(scene.drawn_positions()["cube"], cube)), timeout=10,
+    client = scene_client(scene, page)
+    wait_for(lambda: all(abs(a - b) < 1e-4 for a, b in zip(scene.drawn_positions(client)["cube"], cube)), timeout=10,
              what="the 3D view to draw the cube where the log put it")
     page.close()
 

@@ -14,6 +14,7 @@ import pytest
 from fsm.observation.schema import validate
 from server.http_server import ServerThread
 from server.testing.polling import wait_for
+from scene_support import ViewClient
 from server_support import client
 from sim.pose import DEFAULT_RATE, PoseLayout, PoseTap
 from sim.scene import start_pose_scene, start_scene
@@ -136,47 +137,121 @@ def test_a_joint_the_model_lacks_is_refused():
         PoseLayout(World(seed=0).model).qpos({"joints": {"elbow": 0.3}})
 
 
-# ---------------------------------------------------------------- drawing
+# ---------------------------------------------------------------- drawing, a page's view at a time
 
-def test_show_pose_draws_the_bodies_where_the_recorded_pose_puts_them(scenes):
-    world = moving_world()
+@pytest.fixture
+def views():
+    """Viser clients made by a test (ViewClient: a page's frame of the 3D view), closed after it."""
+    made = []
+    yield made
+    for view in made:
+        view.close()
+
+
+def recorded_then_moved_on(world):
+    """A pose the tap records of ``world`` now, and where its bodies were then; the live arm then moves on."""
     recorded = []
     PoseTap(world, lambda fields: recorded.append((fields, world.data.xpos.copy()))).poll()
-    world.step(400)  # the live arm moves on
+    world.step(400)
+    return recorded[0]
+
+
+def test_a_page_s_pose_is_drawn_in_its_own_view_only(scenes, views):
+    world = moving_world()
+    fields, xpos_then = recorded_then_moved_on(world)
     scene = start_scene(world)
     scenes.append(scene)
-    fields, xpos_then = recorded[0]
-    scene.show_pose(fields)
-    drawn = scene.drawn_positions()
+    looking_back, live = ViewClient(scene), ViewClient(scene)
+    views.extend((looking_back, live))
+    scene.show_pose(looking_back.view, fields)
+    drawn = scene.drawn_positions(looking_back.id)
     assert {"link1", "hand", "finger_left", "cube"} <= set(drawn)
     assert farthest(drawn, world.model, kinematics(world.model, fields).xpos) < FLOAT32
     assert farthest(drawn, world.model, xpos_then) < ONE_STEP
-    assert farthest(drawn, world.model, world.data.xpos) > 0.05  # not the live arm
-    assert scene.label.text == "recorded pose"
+    assert scene.drawn_label(looking_back.id) == "recorded pose"
+    for shown in (scene.drawn_positions(live.id), scene.drawn_positions()):  # the other page, and everyone else
+        assert farthest(shown, world.model, world.data.xpos) < FLOAT32
+    assert scene.drawn_label(live.id) == scene.drawn_label() != "recorded pose"
 
 
-def test_show_pose_none_brings_the_live_world_back(scenes):
+def test_the_live_arm_keeps_moving_for_the_other_views_while_one_looks_back(scenes, views):
     world = moving_world()
-    scene = start_scene(world, always=True)
+    fields, _ = recorded_then_moved_on(world)
+    scene = start_scene(world)
     scenes.append(scene)
-    scene.show_pose(PoseLayout(world.model).fields(PoseLayout(world.model).sample(world.model.qpos0)))
-    scene.show_pose(None)
-    wait_for(lambda: farthest(scene.drawn_positions(), world.model, world.data.xpos) < FLOAT32,
-             what="the live arm drawn again")
+    looking_back, live = ViewClient(scene), ViewClient(scene)
+    views.extend((looking_back, live))
+    scene.show_pose(looking_back.view, fields)
+    world.step(200)
+    wait_for(lambda: farthest(scene.drawn_positions(live.id), world.model, world.data.xpos) < FLOAT32,
+             what="the live view to follow the arm")
+    assert farthest(scene.drawn_positions(looking_back.id), world.model, kinematics(world.model, fields).xpos) < FLOAT32
 
 
-def test_a_pose_scene_has_no_world_and_draws_the_pose_it_is_given(scenes):
+def test_show_pose_none_brings_the_live_arm_back_to_that_view(scenes, views):
+    world = moving_world()
+    scene = start_scene(world)
+    scenes.append(scene)
+    page = ViewClient(scene)
+    views.append(page)
+    scene.show_pose(page.view, PoseLayout(world.model).fields(PoseLayout(world.model).sample(world.model.qpos0)))
+    scene.show_pose(page.view, None)
+    world.step(200)
+    wait_for(lambda: farthest(scene.drawn_positions(page.id), world.model, world.data.xpos) < FLOAT32,
+             what="the live arm drawn in the page's view again")
+    assert scene.drawn_label(page.id) == scene.drawn_label() != "recorded pose"
+
+
+def test_a_view_that_connects_after_its_page_looked_back_is_drawn_the_pose(scenes, views):
+    world = moving_world()
+    fields, _ = recorded_then_moved_on(world)
+    scene = start_scene(world)
+    scenes.append(scene)
+    view = "late0123456789abcdef"
+    scene.show_pose(view, fields)  # the page asked before its frame had connected
+    page = ViewClient(scene, view)
+    views.append(page)
+    assert farthest(scene.drawn_positions(page.id), world.model, kinematics(world.model, fields).xpos) < FLOAT32
+
+
+def test_a_view_closed_while_looking_back_leaves_the_others_live(scenes, views):
+    world = moving_world()
+    fields, _ = recorded_then_moved_on(world)
+    scene = start_scene(world)
+    scenes.append(scene)
+    looking_back, live = ViewClient(scene), ViewClient(scene)
+    views.append(live)
+    scene.show_pose(looking_back.view, fields)
+    looking_back.close()
+    wait_for(lambda: looking_back.id not in scene.clients(), what="viser to see the view's client go")
+    world.step(200)
+    wait_for(lambda: farthest(scene.drawn_positions(live.id), world.model, world.data.xpos) < FLOAT32,
+             what="the other view to follow the live arm")
+    assert scene.drawn_label(live.id) != "recorded pose"
+
+
+def test_a_pose_scene_draws_its_pose_and_each_page_its_own(scenes, views):
     world = moving_world()
     layout = PoseLayout(world.model)
-    fields = layout.fields(layout.sample(world.data.qpos))
-    scene = start_pose_scene(fields)
+    last = layout.fields(layout.sample(world.data.qpos))
+    earlier = layout.fields(layout.sample(world.model.qpos0))
+    scene = start_pose_scene(last)
     scenes.append(scene)
     assert scene.world is None
     assert not [t.name for t in threading.enumerate() if t.name == "sim-scene"]
-    placed = kinematics(world.model, fields).xpos
-    assert farthest(scene.drawn_positions(), world.model, placed) < FLOAT32
-    scene.show_pose(None)  # nothing live to go back to: the pose stays
-    assert farthest(scene.drawn_positions(), world.model, placed) < FLOAT32
+    first, second = ViewClient(scene), ViewClient(scene)
+    views.extend((first, second))
+    scene.show_pose(first.view, earlier)
+    at_last, at_earlier = kinematics(world.model, last).xpos, kinematics(world.model, earlier).xpos
+    assert farthest(scene.drawn_positions(first.id), world.model, at_earlier) < FLOAT32
+    assert farthest(scene.drawn_positions(second.id), world.model, at_last) < FLOAT32
+    scene.show_pose(first.view, None)  # nothing live: the scene's own pose
+    assert farthest(scene.drawn_positions(first.id), world.model, at_last) < FLOAT32
+
+
+def test_a_pose_scene_refuses_a_pose_of_another_robot():
+    with pytest.raises(ValueError, match="no joint 'elbow'"):
+        start_pose_scene({"joints": {"elbow": 0.3}})
 
 
 # ---------------------------------------------------------------- POST /api/scene/pose
@@ -192,22 +267,28 @@ def scene_server(scenes):
         srv.stop()
 
 
-def test_posting_a_pose_draws_it_in_the_scene(scene_server):
+VIEW = "0123456789abcdef0123456789abcdef"
+
+
+def test_posting_a_pose_draws_it_in_that_page_s_view_only(scene_server, views):
     srv, scene = scene_server
+    page, other = ViewClient(scene), ViewClient(scene)
+    views.extend((page, other))
     world = moving_world()
     layout = PoseLayout(world.model)
     fields = layout.fields(layout.sample(world.data.qpos))
     with client(srv) as c:
-        answer = c.post("/api/scene/pose", json={"pose": fields})
+        answer = c.post("/api/scene/pose", json={"view": page.view, "pose": fields})
     assert answer.status_code == 200, answer.text
     assert answer.json() == {"live": False}
-    assert farthest(scene.drawn_positions(), world.model, kinematics(world.model, fields).xpos) < FLOAT32
+    assert farthest(scene.drawn_positions(page.id), world.model, kinematics(world.model, fields).xpos) < FLOAT32
+    assert farthest(scene.drawn_positions(other.id), world.model, kinematics(world.model, {}).xpos) < FLOAT32
 
 
 def test_posting_null_asks_for_the_live_view(scene_server):
     srv, _ = scene_server
     with client(srv) as c:
-        answer = c.post("/api/scene/pose", json={"pose": None})
+        answer = c.post("/api/scene/pose", json={"view": VIEW, "pose": None})
     assert (answer.status_code, answer.json()) == (200, {"live": True})
 
 
@@ -222,19 +303,30 @@ def test_posting_null_asks_for_the_live_view(scene_server):
 def test_a_malformed_pose_is_a_422_that_says_why(scene_server, pose, says):
     srv, _ = scene_server
     with client(srv) as c:
-        answer = c.post("/api/scene/pose", json={"pose": pose})
+        answer = c.post("/api/scene/pose", json={"view": VIEW, "pose": pose})
     assert answer.status_code == 422
     assert says in answer.json()["detail"]
 
 
+@pytest.mark.parametrize("body", [{"pose": None}, {"view": "short", "pose": None},
+                                  {"view": "../" + VIEW, "pose": None}, {"view": 12345678901234567, "pose": None}],
+                         ids=["no view", "too short", "not an id", "not a string"])
+def test_a_pose_for_no_page_s_view_is_a_422_that_says_why(scene_server, body):
+    srv, _ = scene_server
+    with client(srv) as c:
+        answer = c.post("/api/scene/pose", json=body)
+    assert answer.status_code == 422
+    assert "view" in answer.json()["detail"]
+
+
 def test_a_server_without_a_scene_answers_404(live_server):
     with client(live_server) as c:
-        answer = c.post("/api/scene/pose", json={"pose": None})
+        answer = c.post("/api/scene/pose", json={"view": VIEW, "pose": None})
     assert (answer.status_code, answer.json()["detail"]) == (404, "no 3D view")
 
 
 def test_posting_a_pose_needs_the_token(scene_server):
     srv, _ = scene_server
     with client(srv, token=False) as c:
-        answer = c.post("/api/scene/pose", json={"pose": None})
+        answer = c.post("/api/scene/pose", json={"view": VIEW, "pose": None})
     assert answer.status_code == 401

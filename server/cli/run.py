@@ -91,7 +91,7 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
     hub = srv.hub
 
     def serve(name: str, container: Any) -> None:
-        entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path)
+        entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path, script=args.script)
         if robot is not None:  # publishes what the hub encodes; one handle and one Status serve both sides
             robot_follows(robot, entry)
 

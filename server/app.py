@@ -26,6 +26,7 @@ from .lease_control import LeaseControl
 from .middleware import SecurityMiddleware
 from .overview import Overview
 from .read_budget import ReadBudget
+from .refusals import Refusals
 from .routes import control, debug, history, ingest, lease, machines, overview, pages, scene, stream, timeline
 from .settings import Settings
 from .static_files import static_dir
@@ -58,6 +59,7 @@ def create_app(hub: Hub, token: str | None, host: str = "127.0.0.1", port: int |
     app.state.leases = leases
     app.state.overview = Overview(hub)
     app.state.reads = reads or ReadBudget()
+    app.state.refusals = Refusals()
     app.state.show_pose = show_pose
     app.add_exception_handler(StarletteHTTPException, _http_error)
     app.add_exception_handler(RequestValidationError, _validation_error)

@@ -84,10 +84,7 @@ def require_token(request: Request) -> str:
     return role
 
 
-def require_operator(request: Request) -> None:
-    """Dependency for every control: require_token's checks, then 403 for a viewer's token."""
-    if require_token(request) != OPERATOR:
-        raise HTTPException(403, "this token is a viewer's: it may watch, not control (the operator's token may)")
+VIEWER_REFUSAL = "this token is a viewer's: it may watch, not control (the operator's token may)"
 
 
 def websocket_token(websocket: WebSocket) -> str | None:

@@ -138,12 +138,14 @@ class Hub:
 
     def add_local(self, machine: Any, name: str | None = None, path: str = introspection.DEFAULT_ROOT_PATH,
                   can_start: bool = True, starter: Callable[[], Any] | None = None,
-                  holder: Callable[[], Any] | None = None, recording: str | None = None) -> MachineEntry:
+                  holder: Callable[[], Any] | None = None, recording: str | None = None,
+                  script: str | None = None) -> MachineEntry:
         """Observe ``machine`` (any thread). A machine already observed keeps its reporter's name.
 
         ``starter``: what POST .../start calls (in a worker thread) instead of executing the machine
         in a new thread, for a host that runs the machine in its own loop (see control.MachineHandle).
         ``recording``: the log a Recorder writes its events to, where its history older than the ring is read.
+        ``script``: the script that built it (``fsmscope run``): a page follows the newest machine of a script.
         """
         rep = introspection.reporter_of(machine)
         with self._lock:
@@ -154,7 +156,7 @@ class Hub:
             rep = introspection.attach(machine, None, self.unique_name(name or path.rsplit("/", 1)[-1] or "SM_ROOT"),
                                        path)
         handle = MachineHandle(machine, rep, can_start, starter, holder)
-        entry = MachineEntry(rep.machine, Origin("local"), handle,
+        entry = MachineEntry(rep.machine, Origin("local", script=script), handle,
                              LogHistory(recording, rep.machine) if recording is not None else None)
         feed = entry.feed
         feed.status.apply(schema.build.structure(rep.last_seq, time.time(), rep.run, rep.machine, rep.root_path,

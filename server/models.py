@@ -79,6 +79,9 @@ class MachineInfo(BaseModel):
     rejected: int = Field(default=0, description="events refused at the door for not fitting the schema")
     replay: Optional[ReplayInfo] = Field(default=None, description="a machine of `fsmscope replay --serve` "
                                          "(source replay): how the page plays it; null for the others")
+    script: Optional[str] = Field(default=None, description="a machine of `fsmscope run`: the script that built "
+                                  "it (a page that shows one that ended follows the newest of its script); null "
+                                  "for the others")
 
 
 class Tile(BaseModel):

@@ -17,6 +17,7 @@ class Origin:
     robot: str | None = None  # a fleet machine's robot (its name is "<robot>:<machine>")
     replay: dict | None = None  # replayed from a log: {"speed": the page's initial play speed}
     rejected: int = 0  # events refused at the door (ingest) for not fitting the schema
+    script: str | None = None  # a machine of `fsmscope run`: the script that built it (a page follows its newest)
 
     @property
     def gone(self) -> bool:

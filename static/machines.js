@@ -45,6 +45,14 @@ export function showRunState(pill, s, entry) {
   pill.title = s?.error ? `${s.error.exc_type || ""} ${s.error.message || ""}`.trim() : "";
 }
 
+/** The newest machine that the script of `shown` (an /api/machines entry) built, when `shown` ended and
+ * is not it; else null. */
+function newestOfScript(list, shown) {
+  if (!shown.script || shown.running) return null;
+  const newest = list.findLast((m) => m.script === shown.script);
+  return newest === shown ? null : newest;
+}
+
 /** The /api/machines list, polled into the store (store.js), and the picker that opens one of them. */
 export class Machines {
   /** @param {object} handlers {open(name): show that machine, polled(): after each poll, answered or not,
@@ -53,7 +61,11 @@ export class Machines {
     this.picker = picker;
     this.store = store;
     this.handlers = handlers;
-    picker.addEventListener("change", () => handlers.open(picker.value));
+    this.picked = null; // the machine the user chose (in the list, or by the address the page opened): kept shown
+    picker.addEventListener("change", () => {
+      this.picked = picker.value;
+      handlers.open(picker.value);
+    });
   }
 
   async poll() {
@@ -75,12 +87,23 @@ export class Machines {
     }
   }
 
-  /** Open the machine the address names, else a running one, else the first, unless one is shown. */
+  /** Open the machine the address names, else a running one, else the first, unless one is shown; and
+   * when the one shown ended and its script built a newer one (a script that builds a machine per loop),
+   * that one, unless the user chose the one shown or looks back. */
   _pick() {
-    const { name, machines: { list } } = this.store.state;
-    if (name && list.some((m) => m.name === name)) return;
+    const { name, instant, machines: { list } } = this.store.state;
+    const shown = list.find((m) => m.name === name);
+    if (shown) {
+      const newest = name === this.picked || instant.past ? null : newestOfScript(list, shown);
+      if (newest) {
+        this.handlers.open(newest.name);
+        this.store.say(`${name} ended: following ${newest.name}, the newest machine of ${shown.script} (choose one in the list to stay on it)`);
+      }
+      return;
+    }
     const wanted = readLink().machine;
     const pick = list.find((m) => m.name === wanted) || list.find((m) => m.running) || list[0];
+    if (pick && pick.name === wanted) this.picked = wanted;
     if (pick && pick.name !== name) this.handlers.open(pick.name);
   }
 

@@ -219,6 +219,11 @@ class Concurrence(Container):
                     self._done_cond.notify_all()
             reporting.leave(prev)
 
+    def _report_changes(self) -> None:
+        """Under the children's lock: a child's debugger hold reports from that child's thread."""
+        with self._done_cond:
+            Container._report_changes(self)
+
     def _fail(self, label: str, error: BaseException) -> None:
         with self._done_cond:
             self._failed.setdefault(label, error)

@@ -10,12 +10,14 @@ from typing import Callable
 
 Printer = Callable[[str], object]
 
-_printers: dict[str, Printer] = {
+LEVELS = ("debug", "info", "warn", "error")  # least severe first, as rospy's log levels
+_DEFAULT_PRINTERS: dict[str, Printer] = {
     "info": lambda m: print("[  INFO ] : " + str(m)),
     "warn": lambda m: print("[  WARN ] : " + str(m)),
     "debug": lambda m: print("[ DEBUG ] : " + str(m)),
     "error": lambda m: print("[ ERROR ] : " + str(m)),
 }
+_printers: dict[str, Printer] = dict(_DEFAULT_PRINTERS)
 
 # Set by fsm.observation.introspection while a reporter listens: listener(level, message).
 listener: Callable[[str, str], None] | None = None
@@ -57,6 +59,19 @@ def debug_quiet(msg: str) -> None:
 def set_loggers(info: Printer, warn: Printer, debug: Printer, error: Printer) -> None:
     """Rebind the printers; the order is info, warn, debug, error, as in SMACH."""
     _printers.update(info=info, warn=warn, debug=debug, error=error)
+
+
+def print_from(level: str) -> None:
+    """Print the lines of ``level`` and the more severe ones, word for word, and not the others, as
+    rospy's log level does (SMACH prints every level). Only what is printed changes: a listening
+    tool still gets every line as a log event."""
+    least = LEVELS.index(level)
+    _printers.update({name: _DEFAULT_PRINTERS[name] if LEVELS.index(name) >= least else _unprinted
+                      for name in LEVELS})
+
+
+def _unprinted(msg: str) -> None:
+    pass
 
 
 _shutdown_check: Callable[[], bool] = lambda: False

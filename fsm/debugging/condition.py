@@ -12,10 +12,12 @@ from __future__ import annotations
 
 import ast
 import operator
+import re
 from typing import Any, Callable
 
 MAX_LENGTH = 500  # characters of a condition
 MAX_NODES = 200  # nodes of its tree
+_LINES = re.compile("\r\n|\r|\n")  # the line breaks of Python's parser
 
 
 class ConditionError(ValueError):
@@ -69,18 +71,42 @@ def parse_tree(text: str) -> ast.Expression:
         raise ConditionError("a condition must be a non-empty text")
     if len(text) > MAX_LENGTH:
         raise ConditionError("a condition holds at most %d characters, not %d" % (MAX_LENGTH, len(text)))
+    stripped = text.strip()
+    lead = len(text) - len(text.lstrip())  # columns are counted in the text as given
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        tree = ast.parse(stripped, mode="eval")
     except SyntaxError as err:
-        raise ConditionError("not a condition: %s" % (err.msg,), err.offset) from None
+        column = None if err.offset is None else max(err.offset, 1) + lead
+        raise ConditionError("not a condition: %s" % (err.msg,), column) from None
     nodes = list(ast.walk(tree))
     if len(nodes) > MAX_NODES:
         raise ConditionError("a condition holds at most %d parts, not %d" % (MAX_NODES, len(nodes)))
     for node in nodes:
         problem = _refusal(node)
         if problem:
-            raise ConditionError(problem, getattr(node, "col_offset", 0) + 1)
+            raise ConditionError(problem, _column(stripped, node) + lead)
     return tree
+
+
+def _column(text: str, node: ast.AST) -> int:
+    """The 1-based column in its line of ``text`` of the part of ``node`` that is refused: an operator's or
+    a '.''s own, an index's, else where ``node`` begins (an operation begins with its left operand)."""
+    lines = _LINES.split(text)
+    if not 0 < getattr(node, "lineno", 0) <= len(lines):
+        return getattr(node, "col_offset", 0) + 1
+    line = lines[node.lineno - 1].encode()  # ast's offsets count the line's UTF-8 bytes
+
+    def column(offset: int) -> int:
+        return len(line[:offset].decode(errors="replace")) + 1
+
+    if isinstance(node, (ast.BinOp, ast.Attribute)):
+        before = node.left if isinstance(node, ast.BinOp) else node.value
+        if before.end_lineno == node.lineno and before.end_col_offset is not None:
+            after = line[before.end_col_offset:]
+            return column(before.end_col_offset + len(after) - len(after.lstrip(b" \t)")))
+    if isinstance(node, ast.Subscript) and node.slice.lineno == node.lineno:
+        return column(node.slice.col_offset)
+    return column(node.col_offset)
 
 
 def _refusal(node: ast.AST) -> str | None:

@@ -233,6 +233,7 @@ class Debugger:
 
     def _hold(self, container: Any, label: str, at: str, outcome: Any, reason: str, detail: str) -> Hold:
         hold = Hold(container._path, label, at, None if outcome is None else str(outcome), reason, detail)
+        container._report_changes()  # what a hold shows is what its condition saw, not the last transition's
         with self._cond:
             self.mode, self.level = "pause", None  # said by the hold event: a held machine is paused
             self._arm()

@@ -40,7 +40,8 @@ class _Machine:
         self.entered: dict[str, dict[str, float | None]] = {}  # container path -> {label: entered at}
         self.transitions: dict[tuple[str, str, str, str | None], int] = {}
         self.errors: list[dict] = []
-        self.preempts = {"requested": 0, "serviced": 0}
+        # preempt events: "requested" of any container (the machine's own are "of_machine"), "serviced" by any state
+        self.preempts = {"requested": 0, "serviced": 0, "of_machine": 0}
         self.feedback = 0
         self.controls: list[dict] = []
         self.run_time = 0.0  # of the runs that ended
@@ -195,8 +196,10 @@ class Summary:
                              "message": event.get("message")})
         elif kind == "preempt":
             phase = event.get("phase")
-            if phase in m.preempts:
+            if phase in ("requested", "serviced"):
                 m.preempts[phase] += 1
+                if phase == "requested" and path == m.root_path:
+                    m.preempts["of_machine"] += 1
         elif kind == "feedback":
             m.feedback += 1
         elif kind == "control":
@@ -270,7 +273,7 @@ class Summary:
                            "events interleave in this log; each process should record to a file of its own)"
                            % (m["interleaved"], "" if m["interleaved"] == 1 else "s"))
             if m["preempts"]["requested"] or m["preempts"]["serviced"]:
-                out.append("  preempts: %(requested)d requested, %(serviced)d serviced" % m["preempts"])
+                out.append("  preempts: " + _preempts(m["preempts"]))
             if m["errors"]:
                 out.append("  errors:")
                 for err in m["errors"]:
@@ -282,6 +285,20 @@ class Summary:
         if data["problems"]:
             out.append("%d line%s skipped (see above)" % (len(data["problems"]), "" if len(data["problems"]) == 1 else "s"))
         return "\n".join(out)
+
+
+def _preempts(counts: dict) -> str:
+    """The preempts of a machine in words. One preempt of the machine is serviced by each state it
+    reaches (the running leaf, then each container around it, as SMACH's containers do), and a container
+    preempts its own children too (a Concurrence whose child ends it, the debugger forcing an outcome):
+    the preempt events requested and serviced are not counts of one thing."""
+    serviced = counts["serviced"]
+    times = "%d time%s" % (serviced, "" if serviced == 1 else "s")
+    if counts["of_machine"]:
+        return ("%d asked of the machine, serviced %s (by each state and container a preempt reaches, the running "
+                "state first)" % (counts["of_machine"], times))
+    return ("none asked of the machine; serviced %s inside it (a container preempts its own children: a Concurrence "
+            "when one of them ends it, the debugger when it forces an outcome)" % times)
 
 
 def _sec(value: float | None) -> str:

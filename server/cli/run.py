@@ -7,6 +7,8 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
+from fsm.core.log import LEVELS, print_from
+
 from .zenoh_options import ZENOH_OPTIONS, add_zenoh_arguments, robot_follows, zenoh_robot
 from .serving import (SERVER_OPTIONS, SWITCH_INTERVAL, add_server_arguments, announce_viewer, foxglove_unused, given_of,
                       start_server, wait_for_interrupt)
@@ -30,6 +32,9 @@ def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-serve", action="store_true", help="do not serve the dashboard while it runs")
     parser.add_argument("--exit", action="store_true",
                         help="exit when the script ends instead of keeping the dashboard up")
+    parser.add_argument("--log-level", choices=LEVELS, default="info",
+                        help="print SMACH's log lines of this level and above (default: info, as rospy does; "
+                             "debug adds its 'Adding state ...' lines)")
     add_server_arguments(parser, 0)
     add_zenoh_arguments(parser, publish=True)
 
@@ -46,6 +51,7 @@ def unused(args: argparse.Namespace, given: set[str]) -> str | None:
 def main(args: argparse.Namespace) -> int:
     from ..runner import Runner
 
+    print_from(args.log_level)
     runner = Runner(args.script, list(args.extra), args.record, append=args.append)
     refused = runner.prepare()  # no dashboard or robot starts for a script or log that cannot be
     if refused is not None:
@@ -85,7 +91,7 @@ def run_with_dashboard(args: argparse.Namespace, runner: Runner, robot: ZenohRob
     hub = srv.hub
 
     def serve(name: str, container: Any) -> None:
-        entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path)
+        entry = hub.add_local(container, name=name, can_start=True, recording=runner.record_path, script=args.script)
         if robot is not None:  # publishes what the hub encodes; one handle and one Status serve both sides
             robot_follows(robot, entry)
 

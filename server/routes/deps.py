@@ -12,7 +12,7 @@ from starlette.requests import HTTPConnection
 from fsm.control.controls import Controls, Refused
 
 from .. import models
-from ..auth import require_operator, require_token, websocket_refusal
+from ..auth import OPERATOR as OPERATOR_ROLE, VIEWER_REFUSAL, require_token, websocket_refusal
 from ..hub import Hub, MachineEntry
 from ..lease import LeaseHeld
 from ..lease_control import LeaseControl
@@ -22,7 +22,7 @@ from ..read_budget import REQUEST_COST, Meter, ReadBudget, retry_after
 ERRORS = {code: {"model": models.Error} for code in (400, 401, 403, 404, 409, 413, 422)}
 NAME = Path(min_length=1, max_length=200, description="machine name")
 AUTH = [Depends(require_token)]
-OPERATOR = [Depends(require_operator)]  # a control: a viewer's token is answered 403
+CONTROL_PATH = re.compile(r"^/api/machines/\{name\}/([a-z-]+)")  # a control's route: its action
 
 
 def get_hub(connection: HTTPConnection) -> Hub:
@@ -83,6 +83,26 @@ def client_address(request: Request, role: Annotated[str, Depends(require_token)
 ClientAddress = Annotated[str, Depends(client_address)]
 
 
+def record_refusal(request: Request, client: str, why: str) -> None:
+    """A control refused before it reached the machine the path names, written in that machine's audit
+    all the same (server/refusals.py); nothing when there is no such machine."""
+    found = CONTROL_PATH.match(getattr(request.scope.get("route"), "path", ""))
+    entry = request.app.state.hub.get(request.path_params.get("name", ""))
+    if found is not None and entry is not None:
+        address = request.client.host if request.client else ""
+        request.app.state.refusals.record(entry.controls, entry.name, address, found.group(1), client, why)
+
+
+def require_operator(request: Request, role: Annotated[str, Depends(require_token)], page: Page) -> None:
+    """Dependency for every control: 403 for a viewer's token, which the machine's audit records."""
+    if role != OPERATOR_ROLE:
+        record_refusal(request, client_address(request, role, page), VIEWER_REFUSAL)
+        raise HTTPException(403, VIEWER_REFUSAL)
+
+
+OPERATOR = [Depends(require_operator)]  # a control: a viewer's token is answered 403
+
+
 async def read_budget(request: Request, role: Annotated[str, Depends(require_token)],
                       page: Page) -> AsyncIterator[Meter]:
     """Dependency of every read: its client's budget of the server's time (server/read_budget.py). A read
@@ -117,13 +137,14 @@ def get_leases(connection: HTTPConnection) -> LeaseControl:
 Leases = Annotated[LeaseControl, Depends(get_leases)]
 
 
-def require_lease(entry: Machine, controls: MachineControls, page: Page, client: ClientAddress,
+def require_lease(request: Request, entry: Machine, controls: MachineControls, page: Page, client: ClientAddress,
                   leases: Leases) -> None:
     """Dependency of a control that needs the operator lease (server/lease.py): 409 saying who holds it
-    when another page does; a page's first control takes a free one."""
+    when another page does, which the machine's audit records; a page's first control takes a free one."""
     try:
         leases.admit(entry, page, client)
     except LeaseHeld as err:
+        record_refusal(request, client, str(err))
         raise HTTPException(409, str(err)) from None
 
 

@@ -6,12 +6,12 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from fastapi import APIRouter, Body, HTTPException
+from fastapi import APIRouter, Body, HTTPException, Request
 from fastapi.concurrency import run_in_threadpool
 
 from ..control_models import Deadman, LeaseHolder, LeaseRequest, LeaseState
 from ..lease import BEAT_EVERY, Lease, LeaseHeld, short
-from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Leases, Machine, MachineControls, Page
+from .deps import AUTH, ERRORS, OPERATOR, ClientAddress, Leases, Machine, MachineControls, Page, record_refusal
 
 router = APIRouter(dependencies=AUTH, responses=ERRORS, tags=["lease"])
 
@@ -43,13 +43,14 @@ async def lease(entry: Machine, leases: Leases, page: Page) -> LeaseState:
 @router.post("/api/machines/{name}/lease", response_model=LeaseState, dependencies=OPERATOR,
              description="Take control of the machine (409 saying who holds it, unless `takeover`: then "
                          "the other page loses it, and the event says so).")
-async def take(entry: Machine, controls: MachineControls, leases: Leases, page: Page, client: ClientAddress,
-               body: Annotated[LeaseRequest | None, Body()] = None) -> LeaseState:
+async def take(request: Request, entry: Machine, controls: MachineControls, leases: Leases, page: Page,
+               client: ClientAddress, body: Annotated[LeaseRequest | None, Body()] = None) -> LeaseState:
     page = _needs_page(page)
     takeover = body.takeover if body is not None else False
     try:
         await run_in_threadpool(leases.take, entry, page, client, takeover)
     except LeaseHeld as err:
+        await run_in_threadpool(record_refusal, request, client, str(err))
         raise HTTPException(409, str(err)) from None
     return _state(leases, entry.name, page)
 

@@ -28,7 +28,7 @@ async def list_machines(hub: HubDep) -> list[dict]:
                     "can_start": capabilities.can("start"), "controllable": capabilities.unavailable is None,
                     "can_hold": capabilities.can("hold"), "held": bool(controls.held),
                     "source": origin.source, "connected": origin.connected, "rejected": origin.rejected,
-                    "replay": origin.replay})
+                    "replay": origin.replay, "script": origin.script})
     return out
 
 

@@ -161,6 +161,20 @@ def test_the_banner_says_where_and_why_the_machine_holds_in_the_transcripts_word
     assert banner_saying(rounds).endswith("hit breakpoint before C when n >= 1")
 
 
+def test_a_hold_after_a_state_shows_in_the_userdata_panel_what_its_condition_saw(rounds):
+    rounds.click("#pause-btn")
+    banner_saying(rounds, "Paused in")
+    n = rounds.http.get("/api/machines/rounds/status").json()["containers"]["/SM_ROOT"]["userdata"]["n"]
+    target = n + 3  # C adds one a round: the first C to reach it writes exactly it
+    set_breakpoints(rounds, {"state": "/SM_ROOT/C", "at": "after", "when": "n >= %d" % target})
+    rounds.click("#resume-btn")
+    banner_saying(rounds, "hit breakpoint after C")
+    rounds.click('.tree-row[data-path="/SM_ROOT/C"] .label')  # its container's userdata
+    assert rounds.input_value("#ud-container") == "/SM_ROOT"
+    value = rounds.locator('#userdata tr.ud-row[data-key="n"] td.value')
+    assert value.evaluate("td => td.firstChild.textContent") == str(target)  # then its change note: was n - 1
+
+
 def test_a_condition_with_markup_is_shown_as_text(rounds):
     markup = "'<img src=x onerror=alert(1)>' != ''"
     set_breakpoints(rounds, {"state": "/SM_ROOT/C", "at": "before", "when": markup})

@@ -72,3 +72,11 @@ def test_the_picker_says_failed_for_another_machine_whose_run_failed(browser, se
     assert "failed" not in page.text_content('#machine-picker option[value="calm"]')
     assert not page.errors
     page.close()
+
+
+def test_a_traceback_in_the_event_log_keeps_its_line_breaks_as_text(failed):
+    message = failed.locator(".log-row.kind-log.level-error .msg", has_text="Traceback (most recent call last):")
+    shown = message.first.evaluate("el => el.innerText")  # the text as laid out: collapsed spaces are gone
+    assert "Traceback (most recent call last):\n  File " in shown
+    assert shown.rstrip().endswith("ValueError: boom")
+    assert message.first.evaluate("el => el.children.length") == 0  # text, never markup

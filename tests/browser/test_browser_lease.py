@@ -83,6 +83,18 @@ def test_the_audit_lists_each_control_with_who_held_control(loop_page):
     assert loop_page.locator("#audit-dialog .dlg-count").text_content() == "1 of 2 controls"
 
 
+def test_the_audit_lists_a_control_refused_to_a_viewers_token_with_why(loop_page):
+    viewer = httpx.Client(base_url=loop_page.server.base_url, timeout=10,
+                          headers={"Authorization": "Bearer " + loop_page.server.viewer_token})
+    refusal = viewer.post("/api/machines/loop/preempt").json()["detail"]
+    loop_page.click("#audit-btn")
+    loop_page.select_option("#audit-dialog select[name=result]", "refused")
+    row = loop_page.locator("#audit-dialog tbody tr.refused")
+    row.wait_for()
+    cells = row.locator("td").all_text_contents()
+    assert (cells[1], cells[3], cells[5]) == ("127.0.0.1 (viewer)", "preempt", refusal)
+
+
 def debug_mode(http, name) -> str:
     """The debugger's mode of machine ``name`` ("run" when no debugger ever acted on it)."""
     debug = http.get("/api/machines/%s/status" % name).json()["debug"]

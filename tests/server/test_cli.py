@@ -111,6 +111,37 @@ def test_run_names_a_second_machine_after_the_script_with_a_number(tmp_path):
     assert list(summary["machines"]) == ["twice", "twice-2"]
 
 
+def test_run_prints_smachs_info_lines_and_not_its_debug_lines_by_default(tmp_path):
+    done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--record", tmp_path / "r.jsonl")
+    assert done.returncode == 0, done.stderr
+    assert "[  INFO ] : Executing state FOO" in done.stdout
+    assert "[ DEBUG ]" not in done.stdout
+
+
+def test_run_with_log_level_debug_prints_smachs_debug_lines_word_for_word(tmp_path):
+    done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--log-level", "debug", "--record", tmp_path / "r.jsonl")
+    assert done.returncode == 0, done.stderr
+    assert "[ DEBUG ] : Adding state 'FOO' to the state machine." in done.stdout.splitlines()
+
+
+def test_run_with_log_level_warn_prints_no_info_line(tmp_path):
+    done = cli("run", os.path.join(EXAMPLES, "foo_bar.py"), "--log-level", "warn", "--record", tmp_path / "r.jsonl")
+    assert done.returncode == 0, done.stderr
+    assert "[  INFO ]" not in done.stdout
+
+
+def test_run_says_the_dashboards_address_before_the_script_prints_anything(tmp_path):
+    script = tmp_path / "chatty.py"
+    script.write_text("print('the script speaks')\n")
+    out = subprocess.run([sys.executable, "-m", "server.cli", "run", "--exit", str(script), "--record",
+                          str(tmp_path / "r.jsonl")], cwd=ROOT, capture_output=False, stdout=subprocess.PIPE,
+                         stderr=subprocess.STDOUT, text=True, timeout=60,
+                         env=dict(os.environ, PYTHONPATH=ROOT, PYTHONUNBUFFERED="1"))
+    lines = out.stdout.splitlines()
+    assert lines[0].startswith("fsmscope: dashboard at http://127.0.0.1:"), lines
+    assert lines.index("the script speaks") > 0
+
+
 def test_run_accepts_no_serve_and_exit(tmp_path):
     done = cli("run", "--no-serve", "--exit", os.path.join(EXAMPLES, "foo_bar.py"), "--record", tmp_path / "r.jsonl")
     assert done.returncode == 0

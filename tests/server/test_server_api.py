@@ -56,7 +56,7 @@ def test_lists_machines(live_server):
     [info] = client(live_server).get("/api/machines").json()
     assert info == {"name": "two", "running": False, "outcome": None, "last_seq": 0, "root_path": "/SM_ROOT",
                     "can_start": True, "can_hold": False, "held": False, "source": "local", "controllable": True,
-                    "connected": None, "rejected": 0, "replay": None}
+                    "connected": None, "rejected": 0, "replay": None, "script": None}
 
 
 def test_structure_and_status_after_a_run(live_server):

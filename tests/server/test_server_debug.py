@@ -128,3 +128,18 @@ def test_every_debug_control_is_a_control_event_saying_who_and_the_result(loopin
     assert ("pause", "accepted") in controls
     assert any(action == "force" and "is not an outcome" in result for action, result in controls)
     assert all(e["client"] == "127.0.0.1 (operator)" for e in events if e["kind"] == "control")
+
+
+def test_a_hold_after_a_state_shows_the_userdata_its_condition_saw(looping):
+    http, _ = looping
+    http.post("/api/machines/loop/pause")
+    wait_for(lambda: holds(http))
+    n = http.get("/api/machines/loop/status").json()["containers"]["/SM_ROOT"]["userdata"]["n"]
+    target = n + 10 - n % 2  # even: B writes the even counts, so B is where n first reaches it
+    http.put("/api/machines/loop/breakpoints",
+             json={"breakpoints": [{"state": "/SM_ROOT/B", "at": "after", "when": "n >= %d" % target}]})
+    http.post("/api/machines/loop/resume")
+    wait_for(lambda: holds(http) and holds(http)[0]["reason"] == "breakpoint")
+    root = http.get("/api/machines/loop/status").json()["containers"]["/SM_ROOT"]
+    assert root["userdata"]["n"] == target
+    assert root["changes"] == {"n": {"old": target - 1, "new": target}}

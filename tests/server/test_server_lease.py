@@ -80,6 +80,18 @@ def test_another_page_is_refused_while_one_holds_the_lease(served):
     assert "127.0.0.1 (operator, page one) controls machine 'loop' since" in answer.json()["detail"]
 
 
+@pytest.mark.parametrize("method, path, action", [("POST", "/api/machines/loop/resume", "resume"),
+                                                   ("POST", "/api/machines/loop/lease", "lease")])
+def test_a_control_refused_for_the_lease_another_page_holds_is_in_the_audit(served, method, path, action):
+    srv, _ = served
+    page(srv, "one").post("/api/machines/loop/pause")
+    answer = page(srv, "two").request(method, path, json={})
+    assert answer.status_code == 409
+    [refused] = [e for e in controls(srv) if e["result"] != "accepted"]
+    assert (refused["action"], refused["client"], refused["result"]) == (
+        action, "127.0.0.1 (operator, page two)", answer.json()["detail"])
+
+
 def test_a_script_without_a_page_is_refused_while_a_page_holds_the_lease(served):
     srv, _ = served
     page(srv, "one").post("/api/machines/loop/pause")

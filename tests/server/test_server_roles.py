@@ -1,7 +1,10 @@
 """Roles: the operator's token watches and controls, a viewer's token only watches (server/auth.py)."""
 
+import time
+
 import httpx
 import pytest
+from server.refusals import EVERY
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
@@ -44,6 +47,38 @@ def test_a_viewers_control_is_403_saying_why(served, method, path, body):
     response = viewer(served).request(method, path, json=body)
     assert response.status_code == 403
     assert "viewer's" in response.json()["detail"]
+
+
+def refused_controls(srv):
+    events = client(srv).get("/api/machines/two/history", params={"kinds": "control", "limit": 100}).json()["events"]
+    return [(e["action"], e["client"], e["result"]) for e in events if e["result"] != "accepted"]
+
+
+@pytest.mark.parametrize("method, path, body, action", [
+    ("POST", "/api/machines/two/preempt", {}, "preempt"),
+    ("POST", "/api/machines/two/force", {"state": "/SM_ROOT/FOO", "outcome": "go"}, "force"),
+    ("PUT", "/api/machines/two/breakpoints", {"breakpoints": []}, "breakpoints"),
+    ("POST", "/api/machines/two/lease", {}, "lease"),
+])
+def test_a_viewers_refused_control_is_in_the_machines_audit_saying_who_what_and_why(served, method, path, body,
+                                                                                      action):
+    response = viewer(served).request(method, path, json=body, headers={"X-Fsmscope-Page": "viewerpage1"})
+    assert response.status_code == 403
+    assert refused_controls(served) == [(action, "127.0.0.1 (viewer, page viewerpa)", response.json()["detail"])]
+
+
+def test_a_viewer_repeating_a_refused_control_is_recorded_once_a_second_not_each_time(served):
+    http = viewer(served)
+    started = time.monotonic()
+    for _ in range(30):
+        assert http.post("/api/machines/two/preempt").status_code == 403
+    seconds = time.monotonic() - started
+    assert 1 <= len(refused_controls(served)) <= seconds // EVERY + 1 < 30
+
+
+def test_a_viewers_control_of_a_machine_that_is_not_there_is_403_and_recorded_nowhere(served):
+    assert viewer(served).post("/api/machines/nope/preempt").status_code == 403
+    assert refused_controls(served) == []
 
 
 def test_a_viewer_streams_the_machine(served):

@@ -29,9 +29,9 @@ def test_a_condition_evaluates_over_userdata_keys(text, userdata, expected):
 @pytest.mark.parametrize("text, words", [
     ("__import__('os').system('touch /tmp/pwned')", "a call other than len(...) is not allowed (column 1)"),
     ("open('/etc/passwd')", "a call other than len(...) is not allowed (column 1)"),
-    ("x.__class__", "an attribute ('.') is not allowed (column 1)"),
+    ("x.__class__", "an attribute ('.') is not allowed (column 2)"),
     ("(lambda: 1)()", "a call other than len(...) is not allowed"),
-    ("x ** 999999", "this operator (only + and -) is not allowed (column 1)"),
+    ("x ** 999999", "this operator (only + and -) is not allowed (column 3)"),
     ("'a' * 10", "this operator (only + and -) is not allowed"),
     ("[y for y in x]", "a comprehension is not allowed"),
     ("__builtins__", "a name beginning with '__' is not allowed (column 1)"),
@@ -56,6 +56,27 @@ def test_a_syntax_error_names_its_column():
     with pytest.raises(ConditionError) as info:
         Condition("attempts > > 2")
     assert info.value.column == 12
+
+
+@pytest.mark.parametrize("text, column", [
+    ("attempts >> 1", 10),
+    ("attempts > 1 and n ** 2 > 4", 20),
+    ("(attempts) * 2", 12),
+    ("pose.z < 0.1", 5),
+    ("name == 'é' and attempts // 2", 26),
+    ("  attempts >> 1", 12),
+    ("items[n] == 1", 7),
+])
+def test_a_refusal_names_the_column_of_the_part_refused_not_where_its_expression_begins(text, column):
+    with pytest.raises(ConditionError) as info:
+        Condition(text)
+    assert info.value.column == column
+
+
+def test_a_syntax_error_python_places_before_the_text_names_its_first_column():
+    with pytest.raises(ConditionError) as info:
+        Condition("+")
+    assert info.value.column == 1
 
 
 def test_a_missing_key_is_an_error_that_names_it():

@@ -1,5 +1,9 @@
 """fsm.logfiles.summary: outcome, visits and time per state, transitions taken, errors, exit codes."""
 
+import threading
+import time
+
+import fsm
 import pytest
 from fsm.logfiles.log_reader import read_events
 from fsm.logfiles.summary import ERROR, FINISHED, INCOMPLETE, summarize
@@ -131,3 +135,61 @@ def test_a_log_appended_to_by_a_second_process_is_not_two_writers(tmp_path):
     appended.write_text("\n".join(first + second) + "\n")
     summary = summarize(read_events(str(appended)))
     assert summary.machines["m"].interleaved == 0 and summary.exit_code() == 0
+
+
+class _Waiting(fsm.State):
+    """Waits until preempted, services it and returns 'preempted'; ``entered`` is set once it runs."""
+
+    def __init__(self):
+        fsm.State.__init__(self, outcomes=["preempted"])
+        self.entered = threading.Event()
+
+    def execute(self, ud):
+        self.entered.set()
+        while not self.preempt_requested():
+            time.sleep(0.002)
+        self.service_preempt()
+        return "preempted"
+
+
+def _concurrence_that_ends_its_other_child():
+    """RUN (Concurrence): FAST returns at once; its child_termination_cb then preempts SLOW, a machine
+    waiting in WAIT. Nobody preempts the machine."""
+    slow = fsm.StateMachine(outcomes=["preempted"])
+    with slow:
+        fsm.StateMachine.add("WAIT", _Waiting(), {"preempted": "preempted"})
+    run = fsm.Concurrence(outcomes=["done"], default_outcome="done", child_termination_cb=lambda outcomes: True)
+    with run:
+        fsm.Concurrence.add("FAST", fsm.CBState(lambda ud: "done", outcomes=["done"]))
+        fsm.Concurrence.add("SLOW", slow)
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("RUN", run, {"done": "done"})
+    return sm
+
+
+def test_preempts_a_container_made_inside_the_machine_are_not_said_to_be_asked_of_it(tmp_path):
+    path = tmp_path / "run.jsonl"
+    record(_concurrence_that_ends_its_other_child(), path)
+    summary = summarize(read_events(path))
+    assert summary.to_dict()["machines"]["m"]["preempts"]["of_machine"] == 0
+    [line] = [line for line in summary.format().splitlines() if line.startswith("  preempts:")]
+    assert line.startswith("  preempts: none asked of the machine; serviced ")
+    assert "requested" not in line
+
+
+def test_a_preempt_of_the_machine_is_counted_once_however_many_states_serviced_it(tmp_path):
+    path = tmp_path / "run.jsonl"
+    wait = _Waiting()
+    sub = fsm.StateMachine(outcomes=["preempted"])
+    with sub:
+        fsm.StateMachine.add("WAIT", wait, {"preempted": "preempted"})
+    sm = fsm.StateMachine(outcomes=["preempted"])
+    with sm:
+        fsm.StateMachine.add("SUB", sub, {"preempted": "preempted"})
+    threading.Thread(target=lambda: wait.entered.wait(10) and sm.request_preempt()).start()
+    record(sm, path)
+    summary = summarize(read_events(path))
+    preempts = summary.to_dict()["machines"]["m"]["preempts"]
+    assert preempts["of_machine"] == 1 and preempts["serviced"] > 1
+    assert "  preempts: 1 asked of the machine, serviced %d times" % preempts["serviced"] in summary.format()

@@ -184,7 +184,10 @@ function followLink({ machine, seq }) {
   const { name, machines: { list } } = store.state;
   if (machine === null) return;
   if (machine !== name) {
-    if (list.some((m) => m.name === machine)) openMachine(machine); // at the link's seq
+    if (list.some((m) => m.name === machine)) {
+      machines.picked = machine; // the user named it: kept shown, as one chosen in the list
+      openMachine(machine); // at the link's seq
+    }
     else store.say(`No machine named ${machine} here`, "warn");
   } else if (seq !== null) {
     if (!playhead.past || playhead.seq !== seq) playhead.seek({ seq });

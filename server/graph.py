@@ -30,6 +30,7 @@ from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
 from fsm.observation.visible import visible
 
 from .dot import DotError, DotPool
+from .graph_rows import node_size, per_row, ranks, EDGE_CHAR_PT
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -52,6 +53,8 @@ Part = tuple[list[bytes | str], float, float]
 AUTO_OPEN_LIMIT = 150   # without ``expand``: every container open up to this many states, else only the root
 DOT_TIMEOUT = 60.0
 BIG_CONTAINER = 40      # children above which edges are straight lines with external labels
+LABEL_PT = 12           # a state's label, in points (static/graph_geometry.js reads the drawing's scale from it)
+NODE_HEIGHT_IN = 0.4    # a state's box: its label and a little air
 
 
 class GraphError(Exception):
@@ -93,7 +96,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
     g.set("fontsize", "12")
     g.set("nodesep", "0.3")
     g.set("ranksep", "0.4")
-    g.set_node_defaults(fontsize="11", shape="box", style="rounded")
+    g.set_node_defaults(fontsize=str(LABEL_PT), shape="box", style="rounded", height=str(NODE_HEIGHT_IN))
     g.set_edge_defaults(fontsize="9")
     big = len(node.get("children") or ()) > BIG_CONTAINER
     if big:  # dot's spline routing and label placement grow fast with long edges: keep big graphs cheap
@@ -127,6 +130,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
     for outcome in node.get("outcomes") or ():
         outcome_node(outcome)
     outcome_set = set(outcome_nodes.values())
+    row_of = _rows(g, node, names, sizes)  # None: one rank a row
     seen: dict[str, int] = {}
     for tr in node.get("transitions") or ():
         src = names.get(tr["from"])
@@ -145,9 +149,12 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
         if n:
             eid += ":%d" % (n + 1)
         titles[eid] = visible("%s: %s --%s--> %s" % (path, tr["from"], tr["outcome"], target))
-        attrs = {"id": q(eid), ("xlabel" if big else "label"): q(tr["outcome"])}
+        # External labels where rows are made: dot 2.43 corrupts its memory laying out labels of flat edges.
+        attrs = {"id": q(eid), ("xlabel" if big or row_of is not None else "label"): q(tr["outcome"])}
         if dst in outcome_set:  # edges into outcomes do not rank: many long edges to one sink explode dot
             attrs["constraint"] = "false"
+        elif row_of is not None and row_of[src] != row_of[dst]:  # from one row to another: neither ranks
+            attrs.update(constraint="false", weight="0")  # nor pulls (the rows are made by the invisible edges)
         g.add_edge(pydot.Edge(src, dst, **attrs))
     if outcome_nodes:
         sink = pydot.Subgraph(rank="sink")
@@ -155,6 +162,39 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
             sink.add_node(pydot.Node(name))
         g.add_subgraph(sink)
     return g, titles
+
+
+def _rows(g: pydot.Dot, node: dict, names: dict[str, str], sizes: dict[str, tuple[float, float]]) -> dict[str, int] | None:
+    """Wrap the container's states into rows (server/graph_rows.py) when that fits a screen better:
+    each state's row (by dot name), a row's first state kept under the one above it; None: no rows."""
+    children = node.get("children") or ()
+    edges, widest = [], {names[c["label"]]: 0.0 for c in children}
+    for tr in node.get("transitions") or ():
+        src, dst = names.get(tr["from"]), names.get(tr.get("to") or "")
+        if src is None:
+            continue
+        widest[src] = max(widest[src], len(tr["outcome"]) * EDGE_CHAR_PT)
+        if dst is not None:
+            edges.append((src, dst))
+    initial = [names[label] for label in node.get("initial") or () if label in names]
+    rank, _ = ranks(list(widest), initial, edges)
+    boxes = {names[c["label"]]: node_size(c["label"], sizes.get(c["path"])) for c in children}
+    k = per_row(rank, boxes, widest, len(node.get("outcomes") or ()))
+    if k == 1:
+        return None
+    g.set("ranksep", "0.25")  # the rows' edges are labelled beside them (below): no rank of labels between rows
+    row_of = {name: r // k for name, r in rank.items()}
+    heads = []
+    for row in range(max(row_of.values()) + 1):
+        band = pydot.Subgraph(rank="same")
+        members = sorted((name for name in row_of if row_of[name] == row), key=lambda name: rank[name])
+        for name in members:
+            band.add_node(pydot.Node(name))
+        g.add_subgraph(band)
+        heads.append(members[0])
+    for above, below in zip(heads, heads[1:]):  # the rows aligned on the left, as lines of text are
+        g.add_edge(pydot.Edge(above, below, style="invis", weight="10"))
+    return row_of
 
 
 _dot = DotPool(min(os.cpu_count() or 1, 8))

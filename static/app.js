@@ -59,6 +59,7 @@ new Breadcrumb($("crumb-bar"), $("fit"), graph, {
     toolbar.stopFollowing();
     graph.fitPath(path);
   },
+  whole: () => graph.fitWhole(),
 });
 new Minimap($("minimap"), graph, (x, y) => {
   toolbar.stopFollowing();

@@ -6,7 +6,8 @@ container are ranked (a longest path from its initial state, loops left out) and
 are grouped into rows, each drawn left to right (a ``rank=same`` subgraph: dot lays a row's edges
 out as flat ones), the rows top to bottom like the lines of a text. How many ranks a row holds is
 the number whose estimated drawing best fits a box of ASPECT (width / height, a landscape graph
-pane); one rank a row is dot's own drawing.
+pane), of the few best estimated the one dot's drawing of which fits best; one rank a row is dot's
+own drawing.
 """
 
 from __future__ import annotations
@@ -65,12 +66,19 @@ def node_size(label: str, size: tuple[float, float] | None) -> tuple[float, floa
     return max(MIN_NODE_W, len(label) * CHAR_PT + NODE_PAD_PT), NODE_H
 
 
-def per_row(rank: dict[str, int], sizes: dict[str, tuple[float, float]], flat_label: dict[str, float],
-            outcomes: int) -> int:
-    """How many ranks a row holds for the drawing to best fit a box of ASPECT; ``flat_label``: the
-    width of the widest label of an edge out of each child (drawn beside it when the edge is flat)."""
+def fit_score(width: float, height: float) -> float:
+    """How big a drawing of this size is shown in a box of ASPECT (the larger, the more readable)."""
+    return min(ASPECT / width, 1 / height)
+
+
+def row_choices(rank: dict[str, int], sizes: dict[str, tuple[float, float]], flat_label: dict[str, float],
+                outcomes: int, count: int) -> list[int]:
+    """The ``count`` numbers of ranks a row holds whose estimated drawings best fit a box of ASPECT,
+    best first (1: dot's own column); ``flat_label``: the width of the widest label of an edge out of
+    each child (drawn beside it when the edge is flat). An estimate: dot routes edges around rows as
+    it likes, so the caller lays the first few out and keeps the best."""
     depth = max(rank.values(), default=-1) + 1
-    best, best_k = -math.inf, 1
+    scored = []
     for k in range(1, depth + 1):
         rows: dict[int, list[str]] = {}
         for child, r in rank.items():
@@ -79,7 +87,5 @@ def per_row(rank: dict[str, int], sizes: dict[str, tuple[float, float]], flat_la
         height = sum(max(sizes[c][1] for c in row) for row in rows.values()) + ROW_GAP_PT * (len(rows) - 1)
         if outcomes:
             height += OUTCOME_ROW_PT
-        fit = min(ASPECT / width, 1 / height)
-        if fit > best * 1.02:  # fewer ranks a row unless more fit clearly better
-            best, best_k = fit, k
-    return best_k
+        scored.append((-fit_score(width, height), k))
+    return [k for _, k in sorted(scored)[:count]] or [1]

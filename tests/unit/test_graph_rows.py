@@ -12,6 +12,17 @@ from server.graph_rows import ranks
 from server_support import mission_machine
 
 
+def sequence(steps: int) -> fsm.StateMachine:
+    """S0 -> S1 -> ... -> succeeded, each step able to fail the whole ('aborted')."""
+    sm = fsm.StateMachine(outcomes=["succeeded", "aborted"])
+    with sm:
+        for i in range(steps):
+            after = "S%d" % (i + 1) if i + 1 < steps else "succeeded"
+            fsm.StateMachine.add("S%d" % i, fsm.CBState(lambda ud: "done", outcomes=["done", "failed"]),
+                                 {"done": after, "failed": "aborted"})
+    return sm
+
+
 def drawn_size(sm) -> tuple[float, float]:
     """The width and height (points) of the server's drawing of ``sm``, every container open."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
@@ -30,6 +41,11 @@ def test_a_31_state_script_is_drawn_wider_than_tall():
 def test_a_31_state_script_fits_a_laptops_graph_pane_with_labels_of_9_px():
     w, h = drawn_size(mission_machine())
     assert min(744 / w, 542 / h) * graph.LABEL_PT >= 9.5  # the pane at 1440 x 900, a 9 px floor and a margin
+
+
+def test_a_sequence_of_30_states_fits_a_laptops_graph_pane_with_labels_of_9_px():
+    w, h = drawn_size(sequence(30))
+    assert min(744 / w, 542 / h) * graph.LABEL_PT >= 9.5
 
 
 def test_states_are_ranked_by_their_longest_path_from_the_initial_state_loops_left_out():

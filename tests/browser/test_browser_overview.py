@@ -127,6 +127,7 @@ def test_a_big_machine_opens_on_its_active_state_with_readable_labels(big_page):
 
 def test_the_fit_note_offers_the_whole_graph_in_one_click(big_page):
     open_all(big_page)
+    big_page.uncheck("#follow")  # the view stays the fit's until the click
     big_page.click("#fit")
     assert "px labels" in big_page.text_content(".fit-note")
     big_page.click(".fit-whole")
@@ -154,6 +155,7 @@ def test_the_fit_note_goes_once_the_view_is_another(big_page, move):
 
 def test_a_partial_fit_keeps_the_states_it_shows_clear_of_the_minimap(big_page):
     open_all(big_page)
+    big_page.uncheck("#follow")
     big_page.click("#fit")
     assert big_page.is_visible("#minimap")
     assert [label["label"] for label in big_page.evaluate(LABELS) if label["under"]] == []

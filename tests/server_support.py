@@ -88,34 +88,6 @@ def nested_machine():
     return sm
 
 
-# A newcomer's own script of 31 states (the root included): a mission of twelve steps, three of
-# them sub-machines of six, every step able to fail the whole.
-MISSION = ["INIT", "CHECK_BATTERY", "LOCALIZE",
-           ("NAVIGATE", ["PLAN_PATH", "FOLLOW_PATH", "AVOID", "REPLAN", "ARRIVE", "ALIGN"]), "DETECT",
-           ("GRASP", ["OPEN_GRIPPER", "APPROACH", "DESCEND", "CLOSE", "VERIFY", "LIFT"]),
-           ("DELIVER", ["TRANSPORT", "LOWER", "RELEASE", "RETREAT", "CONFIRM", "LOG_RESULT"]),
-           "RETURN_HOME", "DOCK", "CHARGE", "REPORT", "SHUTDOWN"]
-
-
-def mission_machine(gate: threading.Event | None = None):
-    """``MISSION`` as a machine: each step says 'done' (a step waits for ``gate`` when one is given),
-    'failed' ends its machine 'aborted'."""
-    def sequence(steps):
-        sm = fsm.StateMachine(outcomes=["succeeded", "aborted"])
-        with sm:
-            for i, step in enumerate(steps):
-                label = step if isinstance(step, str) else step[0]
-                after = steps[i + 1] if i + 1 < len(steps) else "succeeded"
-                after = after if isinstance(after, str) else after[0]
-                if isinstance(step, str):
-                    state = fsm.CBState(lambda ud: gate.wait() and "done" if gate else "done", outcomes=["done", "failed"])
-                    fsm.StateMachine.add(label, state, {"done": after, "failed": "aborted"})
-                else:
-                    fsm.StateMachine.add(label, sequence(step[1]), {"succeeded": after, "aborted": "aborted"})
-        return sm
-    return sequence(MISSION)
-
-
 def client(srv, token=True):
     headers = {"Authorization": "Bearer " + srv.token} if token else {}
     return httpx.Client(base_url=srv.base_url, headers=headers, timeout=10)

@@ -13,7 +13,7 @@ import pytest
 from browser_support import page_at, serving_while_running
 from server.http_server import ServerThread
 from server.testing.big_machine import big_machine
-from server_support import mission_machine
+from server.testing.mission import mission_machine
 
 WIDTH, HEIGHT = 1440, 900
 FLOOR_PX = 9  # a state's label on screen, at least

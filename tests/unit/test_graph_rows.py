@@ -9,18 +9,7 @@ import fsm
 from fsm.observation import structure
 from server import graph
 from server.graph_rows import ranks
-from server_support import mission_machine
-
-
-def sequence(steps: int) -> fsm.StateMachine:
-    """S0 -> S1 -> ... -> succeeded, each step able to fail the whole ('aborted')."""
-    sm = fsm.StateMachine(outcomes=["succeeded", "aborted"])
-    with sm:
-        for i in range(steps):
-            after = "S%d" % (i + 1) if i + 1 < steps else "succeeded"
-            fsm.StateMachine.add("S%d" % i, fsm.CBState(lambda ud: "done", outcomes=["done", "failed"]),
-                                 {"done": after, "failed": "aborted"})
-    return sm
+from server.testing.mission import mission_machine, sequence_machine
 
 
 def drawn_size(sm) -> tuple[float, float]:
@@ -44,7 +33,7 @@ def test_a_31_state_script_fits_a_laptops_graph_pane_with_labels_of_9_px():
 
 
 def test_a_sequence_of_30_states_fits_a_laptops_graph_pane_with_labels_of_9_px():
-    w, h = drawn_size(sequence(30))
+    w, h = drawn_size(sequence_machine(30))
     assert min(744 / w, 542 / h) * graph.LABEL_PT >= 9.5
 
 

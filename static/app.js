@@ -61,7 +61,7 @@ new Breadcrumb($("crumb-bar"), $("fit"), graph, {
   },
   whole: () => graph.fitWhole(),
 });
-new Minimap($("minimap"), graph, (x, y) => {
+new Minimap($("minimap"), $("minimap-on"), graph, (x, y) => {
   toolbar.stopFollowing();
   graph.centreOn(x, y);
 });

@@ -1,8 +1,8 @@
 // The minimap: the whole drawing's outline (its open containers' frames, drawn once per layout), the
 // rectangle the graph pane shows and the active state's box (at least a few px, never more than the
 // state); a click or a drag on it pans there. It lies over the graph pane's bottom right corner, so it
-// is shown only while the view shows part of the drawing (the whole needs no map), and the graph keeps
-// what it fits or follows clear of it (GraphView.inset).
+// is shown only while the view shows part of the drawing (the whole needs no map) and its checkbox is
+// ticked, and the graph keeps what it fits or follows clear of it (GraphView.inset).
 // It follows the GraphView's events (graph.js), redrawn at most once per animation frame, and reads
 // the active state's box once per element and layout (from the drawing's attributes), so following a
 // fast machine costs a few attribute writes a frame.
@@ -23,11 +23,13 @@ function svgEl(name, attributes = {}) {
 export class Minimap {
   /**
    * @param {HTMLElement} host the minimap's box (over the graph pane)
+   * @param {HTMLInputElement} toggle its checkbox: unticked, it is never shown
    * @param {import("./graph.js").GraphView} graph
    * @param {(x: number, y: number) => void} pan centre the graph on this point of its user space
    */
-  constructor(host, graph, pan) {
+  constructor(host, toggle, graph, pan) {
     this.host = host;
+    this.toggle = toggle;
     this.graph = graph;
     this.svg = host.appendChild(svgEl("svg", { preserveAspectRatio: "xMidYMid meet", "aria-hidden": "true" }));
     this.outline = this.svg.appendChild(svgEl("g", { class: "mm-outline" }));
@@ -36,6 +38,10 @@ export class Minimap {
     this.boxes = new Map(); // element id -> its box in user space, for this layout
     this.queued = false;
     graph.inset = MINIMAP_INSET;
+    toggle.addEventListener("change", () => {
+      graph.inset = toggle.checked ? MINIMAP_INSET : 0;
+      this._queue();
+    });
     graph.host.addEventListener("graph:layout", () => this._draw());
     for (const type of ["graph:view", "graph:focus"]) graph.host.addEventListener(type, () => this._queue());
     this._bindPointer(pan);
@@ -70,7 +76,8 @@ export class Minimap {
     const slack = 1; // user units: a fit's rounding
     const whole = vb.x <= base.x + slack && vb.y <= base.y + slack && vb.x + vb.w >= base.x + base.w - slack
       && vb.y + vb.h >= base.y + base.h - slack;
-    if (this.host.hidden !== whole) this.host.hidden = whole;
+    const hidden = whole || !this.toggle.checked;
+    if (this.host.hidden !== hidden) this.host.hidden = hidden;
     for (const [name, value] of [["x", vb.x], ["y", vb.y], ["width", vb.w], ["height", vb.h]]) this.view.setAttribute(name, value);
     const el = activePath ? this.graph.stateElement(activePath) : null;
     if (!el) {

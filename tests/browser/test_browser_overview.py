@@ -177,3 +177,14 @@ def test_the_minimap_marks_the_active_state_no_bigger_than_it_is(big_page):
     }""").json_value()
     for mark, state in zip(sizes["mark"], sizes["state"]):
         assert mark <= max(state, sizes["floor"]) + 0.5
+
+
+def test_the_minimap_can_be_hidden(big_page):
+    open_all(big_page)
+    big_page.uncheck("#follow")
+    big_page.click("#fit")
+    assert big_page.is_visible("#minimap")
+    big_page.uncheck("#minimap-on")
+    big_page.wait_for_selector("#minimap", state="hidden")
+    big_page.click("#zoom-in")
+    assert big_page.is_hidden("#minimap")

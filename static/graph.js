@@ -110,6 +110,7 @@ export class GraphView {
 
   clear(message) {
     this.svg = null;
+    this.activePath = null; // another machine's: its first view is fitted on its own active state
     this.marks = null;
     this.stage = null;
     this.key = null;

@@ -96,8 +96,9 @@ def test_fit_shows_the_whole_machine_and_says_nothing_more(first_view):
 
 @pytest.fixture(scope="module")
 def big():
-    """600 states (40 containers), running: each leaf 0.2 s."""
+    """600 states (40 containers), running: each leaf 0.2 s; beside it the 31-state mission."""
     with serving_while_running(*big_machine(3, 4, 14, tick=0.2), "big") as srv:
+        srv.hub.add_local(mission_machine(), name="mission")  # never run
         yield srv
 
 
@@ -151,6 +152,17 @@ def test_the_fit_note_goes_once_the_view_is_another(big_page, move):
         big_page.click(move)
     assert big_page.text_content(".fit-note") == ""
     assert "Fit shows" not in big_page.get_attribute("#fit", "title")
+
+
+def test_the_fit_note_goes_with_the_machine_it_was_about(big_page):
+    open_all(big_page)
+    big_page.uncheck("#follow")
+    big_page.click("#fit")
+    assert "Fit shows" in big_page.text_content(".fit-note")
+    big_page.select_option("#machine-picker", "mission")
+    big_page.wait_for_selector('#graph [id="s:/SM_ROOT/SHUTDOWN"]', state="attached")
+    assert big_page.text_content(".fit-note") == ""
+    assert all(label["inside"] for label in big_page.evaluate(LABELS))
 
 
 def test_a_partial_fit_keeps_the_states_it_shows_clear_of_the_minimap(big_page):

@@ -178,7 +178,7 @@ def _ranking(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[dict[st
         if tr.get("to") in labels:
             edges.append((tr["from"], tr["to"]))
     initial = [label for label in node.get("initial") or () if label in labels]
-    rank, _ = ranks(list(widest), initial, edges)
+    rank = ranks(list(widest), initial, edges)
     return rank, {c["label"]: node_size(c["label"], sizes.get(c["path"])) for c in children}, widest
 
 

@@ -5,14 +5,12 @@ thirty boxes tall (2,300 points), whose labels no screen shows readable whole. H
 container are ranked (a longest path from its initial state, loops left out) and consecutive ranks
 are grouped into rows, each drawn left to right (a ``rank=same`` subgraph: dot lays a row's edges
 out as flat ones), the rows top to bottom like the lines of a text. How many ranks a row holds is
-the number whose estimated drawing best fits a box of ASPECT (width / height, a landscape graph
-pane), of the few best estimated the one dot's drawing of which fits best; one rank a row is dot's
-own drawing.
+chosen by the drawing's fit to a box of ASPECT (width / height, a landscape graph pane): the sizes
+of every choice are estimated here, and server/graph.py has dot lay the few best out and keeps the
+one that fits best (dot routes edges around rows as it likes). One rank a row is dot's own drawing.
 """
 
 from __future__ import annotations
-
-import math
 
 ASPECT = 1.5  # width / height of the box a drawing is made to fit: the graph pane of a laptop's page
 CHAR_PT = 7.6  # a label's width per character (12 pt Times, mostly capitals)
@@ -25,9 +23,9 @@ ROW_GAP_PT = 36.0  # between two rows: ranksep and an edge label
 OUTCOME_ROW_PT = 60.0  # the outcomes' row at the bottom, with its gap
 
 
-def ranks(children: list[str], initial: list[str], edges: list[tuple[str, str]]) -> tuple[dict[str, int], set[tuple[str, str]]]:
-    """Each child's rank (the longest path to it from the initial states, then from the others in
-    order) and the edges that loop back (found by a depth-first walk: left out of the ranking)."""
+def ranks(children: list[str], initial: list[str], edges: list[tuple[str, str]]) -> dict[str, int]:
+    """Each child's rank: the longest path to it from the initial states, then from the others in
+    order, the edges that loop back (found by a depth-first walk) left out."""
     out: dict[str, list[str]] = {c: [] for c in children}
     for a, b in edges:
         out[a].append(b)
@@ -56,7 +54,7 @@ def ranks(children: list[str], initial: list[str], edges: list[tuple[str, str]])
         for nxt in out[node]:
             if (node, nxt) not in back:
                 rank[nxt] = max(rank[nxt], rank[node] + 1)
-    return rank, back
+    return rank
 
 
 def node_size(label: str, size: tuple[float, float] | None) -> tuple[float, float]:

@@ -33,6 +33,14 @@ LABELS = """() => {
 }"""
 
 
+# LABELS of the elements whose ids hold a path part (an open container's frame and what is in it).
+LABELS_IN = """(part) => {
+  const all = (%s)();
+  const texts = [...document.querySelectorAll('#graph svg.fsm-graph :is(g.node.state, g.node.container, g.cluster) > text')];
+  return all.filter((label, i) => texts[i].parentElement.id.includes(part));
+}""" % LABELS
+
+
 def demo_machine():
     """The demo's pick-and-place machine (sim/task.py) on its simulated world, not run."""
     from sim.task import build_task_machine
@@ -165,12 +173,23 @@ def test_the_fit_note_goes_with_the_machine_it_was_about(big_page):
     assert all(label["inside"] for label in big_page.evaluate(LABELS))
 
 
-def test_a_partial_fit_keeps_the_states_it_shows_clear_of_the_minimap(big_page):
+def test_a_fit_of_the_selections_container_keeps_its_states_clear_of_the_minimap(big_page):
     open_all(big_page)
     big_page.uncheck("#follow")
+    big_page.keyboard.press("Control+k")  # the search palette: the state chosen is selected
+    big_page.fill("#search-dialog input", "W_0_0_0_13")
+    big_page.wait_for_selector("#search-dialog li[aria-selected=true]")
+    big_page.keyboard.press("Enter")
     big_page.click("#fit")
+    assert "Fit shows TASK_0_0_0" in big_page.text_content(".fit-note")
     assert big_page.is_visible("#minimap")
-    assert [label["label"] for label in big_page.evaluate(LABELS) if label["under"]] == []
+    labels = big_page.evaluate(LABELS_IN, "/TASK_0/TASK_0_0/TASK_0_0_0")
+    assert len(labels) == 15  # its 14 states and its own label
+    assert [label["label"] for label in labels if label["under"] or not label["inside"]] == []
+    frame = big_page.eval_on_selector('[id="c:%s/TASK_0/TASK_0_0/TASK_0_0_0"] > polygon' % big_page.evaluate("window.fsmscope.status.root_path"),
+                                      "el => { const b = el.getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; }")
+    minimap = big_page.eval_on_selector("#minimap", "el => { const b = el.getBoundingClientRect(); return [b.left, b.top, b.right, b.bottom]; }")
+    assert frame[3] <= minimap[1] or frame[2] <= minimap[0]  # the whole frame above or left of the minimap
 
 
 def test_the_minimap_marks_the_active_state_no_bigger_than_it_is(big_page):

@@ -48,6 +48,7 @@ bench: install
 	$(PY) bench/live_rewind.py
 	$(PY) bench/debugger.py
 	$(PY) bench/big_machine_browser.py
+	$(PY) bench/first_view_browser.py
 	$(PY) bench/server.py
 	$(PY) bench/graph.py
 	$(PY) bench/sim.py

@@ -30,6 +30,7 @@ from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
 from fsm.observation.visible import visible
 
 from .dot import DotError, DotPool
+from .graph_rows import EDGE_CHAR_PT, fit_score, node_size, ranks, row_choices
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -50,8 +51,11 @@ _DECLARATIONS = re.compile(rb' xmlns(?::xlink)?="(?:%s|%s)"' % (SVG_NS.encode(),
 Part = tuple[list[bytes | str], float, float]
 
 AUTO_OPEN_LIMIT = 150   # without ``expand``: every container open up to this many states, else only the root
+ROW_TRIALS = 6          # drawings of a container in rows laid out to keep the best, up to AUTO_OPEN_LIMIT states
 DOT_TIMEOUT = 60.0
 BIG_CONTAINER = 40      # children above which edges are straight lines with external labels
+LABEL_PT = 12           # a state's label, in points (static/graph_geometry.js reads the drawing's scale from it)
+NODE_HEIGHT_IN = 0.4    # a state's box: its label and a little air
 
 
 class GraphError(Exception):
@@ -81,9 +85,10 @@ def described(node: dict) -> str:
     return visible("%s (%s)" % (node["path"], node.get("type", "")))
 
 
-def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.Dot, dict[str, str]]:
+def build_dot(node: dict, sizes: dict[str, tuple[float, float]], per_row: int = 1) -> tuple[pydot.Dot, dict[str, str]]:
     """One container's graph, and the title of each element by id (dot would title them by its own
-    node names, "n12"); ``sizes`` gives the drawing size (points) of each open child container."""
+    node names, "n12"); ``sizes`` gives the drawing size (points) of each open child container;
+    ``per_row``: how many ranks of its states a row holds (``row_choices``; 1: dot's own column)."""
     path = node["path"]
     titles = {container_id(path): described(node)}
     g = pydot.Dot(q(path), graph_type="digraph")
@@ -93,7 +98,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
     g.set("fontsize", "12")
     g.set("nodesep", "0.3")
     g.set("ranksep", "0.4")
-    g.set_node_defaults(fontsize="11", shape="box", style="rounded")
+    g.set_node_defaults(fontsize=str(LABEL_PT), shape="box", style="rounded", height=str(NODE_HEIGHT_IN))
     g.set_edge_defaults(fontsize="9")
     big = len(node.get("children") or ()) > BIG_CONTAINER
     if big:  # dot's spline routing and label placement grow fast with long edges: keep big graphs cheap
@@ -127,6 +132,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
     for outcome in node.get("outcomes") or ():
         outcome_node(outcome)
     outcome_set = set(outcome_nodes.values())
+    row_of = _rows(g, node, names, per_row)  # None: one rank a row
     seen: dict[str, int] = {}
     for tr in node.get("transitions") or ():
         src = names.get(tr["from"])
@@ -145,9 +151,12 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
         if n:
             eid += ":%d" % (n + 1)
         titles[eid] = visible("%s: %s --%s--> %s" % (path, tr["from"], tr["outcome"], target))
-        attrs = {"id": q(eid), ("xlabel" if big else "label"): q(tr["outcome"])}
+        # External labels where rows are made: dot 2.43 corrupts its memory laying out labels of flat edges.
+        attrs = {"id": q(eid), ("xlabel" if big or row_of is not None else "label"): q(tr["outcome"])}
         if dst in outcome_set:  # edges into outcomes do not rank: many long edges to one sink explode dot
             attrs["constraint"] = "false"
+        elif row_of is not None and row_of[src] != row_of[dst]:  # from one row to another: neither ranks
+            attrs.update(constraint="false", weight="0")  # nor pulls (the rows are made by the invisible edges)
         g.add_edge(pydot.Edge(src, dst, **attrs))
     if outcome_nodes:
         sink = pydot.Subgraph(rank="sink")
@@ -155,6 +164,49 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[pydot.
             sink.add_node(pydot.Node(name))
         g.add_subgraph(sink)
     return g, titles
+
+
+def _ranking(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[dict[str, int], dict[str, tuple[float, float]], dict[str, float]]:
+    """A container's states (by label): their ranks, estimated sizes and widest outgoing edge label."""
+    children = node.get("children") or ()
+    labels = {c["label"] for c in children}
+    edges, widest = [], {c["label"]: 0.0 for c in children}
+    for tr in node.get("transitions") or ():
+        if tr["from"] not in labels:
+            continue
+        widest[tr["from"]] = max(widest[tr["from"]], len(tr["outcome"]) * EDGE_CHAR_PT)
+        if tr.get("to") in labels:
+            edges.append((tr["from"], tr["to"]))
+    initial = [label for label in node.get("initial") or () if label in labels]
+    rank = ranks(list(widest), initial, edges)
+    return rank, {c["label"]: node_size(c["label"], sizes.get(c["path"])) for c in children}, widest
+
+
+def row_options(node: dict, sizes: dict[str, tuple[float, float]], count: int) -> list[int]:
+    """The ``count`` best estimated numbers of ranks a row of the container holds (server/graph_rows.py)."""
+    rank, boxes, widest = _ranking(node, sizes)
+    return row_choices(rank, boxes, widest, len(node.get("outcomes") or ()), count)
+
+
+def _rows(g: pydot.Dot, node: dict, names: dict[str, str], per_row: int) -> dict[str, int] | None:
+    """Wrap the container's states into rows of ``per_row`` ranks (server/graph_rows.py): each
+    state's row (by dot name), a row's first state kept under the one above it; None: no rows."""
+    if per_row <= 1:
+        return None
+    rank = {names[label]: r for label, r in _ranking(node, {})[0].items()}
+    g.set("ranksep", "0.25")  # the rows' edges are labelled beside them (below): no rank of labels between rows
+    row_of = {name: r // per_row for name, r in rank.items()}
+    heads = []
+    for row in range(max(row_of.values()) + 1):
+        band = pydot.Subgraph(rank="same")
+        members = sorted((name for name in row_of if row_of[name] == row), key=lambda name: rank[name])
+        for name in members:
+            band.add_node(pydot.Node(name))
+        g.add_subgraph(band)
+        heads.append(members[0])
+    for above, below in zip(heads, heads[1:]):  # the rows aligned on the left, as lines of text are
+        g.add_edge(pydot.Edge(above, below, style="invis", weight="10"))
+    return row_of
 
 
 _dot = DotPool(min(os.cpu_count() or 1, 8))
@@ -221,7 +273,7 @@ class Renderer:
             if doc is not None:
                 self._docs.move_to_end(doc_key)
                 return doc
-            doc = self._render(root, key, opened)
+            doc = self._render(root, key, opened, ROW_TRIALS if n_states <= AUTO_OPEN_LIMIT else 1)
             self._docs[doc_key] = doc
             while len(self._docs) > self._max_docs:
                 self._docs.popitem(last=False)
@@ -231,7 +283,8 @@ class Renderer:
         prefix = node["path"] + "/"
         return (key, node["path"], frozenset(p for p in opened if p.startswith(prefix)))
 
-    def _render(self, root: dict, key: str, opened: frozenset[str]) -> bytes:
+    def _render(self, root: dict, key: str, opened: frozenset[str], trials: int) -> bytes:
+        """The document; each container laid out in rows ``trials`` ways (row_options), the best kept."""
         by_depth: dict[int, list[dict]] = collections.defaultdict(list)
         for node, depth in structure.walk(root, lambda c: c["path"] in opened):
             if node["path"] in opened:
@@ -252,10 +305,11 @@ class Renderer:
             built = []
             for node, _ in todo:
                 sizes = {c["path"]: done[c["path"]][1:] for c in node.get("children") or () if c["path"] in done}
-                built.append(build_dot(node, sizes))
-            svgs = run_dot_parallel([g for g, _ in built])
+                built.append([build_dot(node, sizes, k) for k in row_options(node, sizes, trials)])
+            drawn = iter(run_dot_parallel([g for ways in built for g, _ in ways]))
             self.layouts += len(todo)
-            for (node, pkey), svg, (_, titles) in zip(todo, svgs, built):
+            for (node, pkey), ways in zip(todo, built):
+                svg, titles = max(((next(drawn), titles) for _, titles in ways), key=lambda d: fit_score(*_size(d[0])))
                 part = self._compose(node, svg, done, titles)
                 done[node["path"]] = part
                 self._parts[pkey] = part

@@ -60,8 +60,9 @@ new Breadcrumb($("crumb-bar"), $("fit"), graph, {
     toolbar.stopFollowing();
     graph.fitPath(path);
   },
+  whole: () => graph.fitWhole(),
 });
-new Minimap($("minimap"), graph, (x, y) => {
+new Minimap($("minimap"), $("minimap-on"), graph, (x, y) => {
   toolbar.stopFollowing();
   graph.centreOn(x, y);
 });

@@ -2,7 +2,7 @@
 // while following, else the deepest open container whose frame holds the view's centre), each crumb
 // fitting its container, and what the last fit shows when the whole graph would be unreadable. It
 // follows the GraphView's events (graph.js), at most once per animation frame, and rebuilds its
-// crumbs only when the container changes.
+// crumbs only when the container changes. The fit's note offers the whole graph, one click away.
 
 import { h } from "./dom.js";
 import { clusterAt } from "./graph_geometry.js";
@@ -13,14 +13,17 @@ export class Breadcrumb {
    * @param {HTMLElement} host the breadcrumb's bar
    * @param {HTMLElement} fitButton its title says what a fit shows
    * @param {import("./graph.js").GraphView} graph
-   * @param {{label: (path: string) => string, fit: (path: string) => void}} handlers a container's
-   *   name; fit a container (a crumb was clicked)
+   * @param {{label: (path: string) => string, fit: (path: string) => void, whole: () => void}} handlers
+   *   a container's name; fit a container (a crumb was clicked); show the whole graph (the note's button)
    */
   constructor(host, fitButton, graph, handlers) {
     this.graph = graph;
     this.handlers = handlers;
     this.crumbs = host.appendChild(h("ol", { class: "crumbs", "aria-label": "Container in view" }));
     this.note = host.appendChild(h("span", { class: "fit-note", role: "status" }));
+    this.whole = host.appendChild(h("button", { type: "button", class: "fit-whole", text: "whole graph",
+      title: "Show the whole graph, however small its labels", hidden: true }));
+    this.whole.addEventListener("click", () => handlers.whole());
     this.fitButton = fitButton;
     this.fitTitle = fitButton.title;
     this.shown = undefined; // the container path the crumbs name
@@ -60,9 +63,11 @@ export class Breadcrumb {
       h("button", { type: "button", "data-path": p, text: this.handlers.label(p), title: "Fit " + p }))));
   }
 
-  /** What the last fit shows: said beside the crumbs and in the Fit button's title. */
+  /** What the fit shown shows ("": the whole graph, or the view is no fit): said beside the crumbs and
+   * in the Fit button's title. */
   _fitted(note) {
     this.note.textContent = note;
+    this.whole.hidden = !note;
     this.fitButton.title = note ? this.fitTitle + ". " + note : this.fitTitle;
   }
 }

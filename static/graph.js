@@ -13,8 +13,8 @@
 // One piece on purpose: loading, marking and the view box all act on the same inlined SVG, its
 // element index and the boxes measured on it.
 
-import { anchorAfter, anchorBefore, readableFit } from "./graph_fit.js";
-import { COMFORT_SCALE, READABLE_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox, viewAt } from "./graph_geometry.js";
+import { anchorAfter, anchorBefore, partView, readableFit } from "./graph_fit.js";
+import { COMFORT_SCALE, READABLE_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox } from "./graph_geometry.js";
 import { GraphMarks } from "./graph_marks.js";
 import { bindPointer } from "./graph_pointer.js";
 import { markExactly } from "./dom.js";
@@ -47,9 +47,13 @@ export class GraphView {
     this.stageScale = null; // px per SVG unit the stage is sized for
     this.size = null; // the host's size in px, kept by a ResizeObserver (reading it would force a layout)
     this.boxes = new Map(); // element id -> its box in user space (measured once per drawing)
+    this.fitted = null; // the view box the last fit showed, while it is shown
+    this.note = ""; // what that fit says it shows ("": the whole graph, or no fit shown)
+    this.inset = 0; // px at the bottom of the host a part of the drawing is kept clear of (the minimap)
     new ResizeObserver(() => {
       this.size = null;
-      if (this.vb) this.setViewBox(this.vb);
+      if (this.vb && this.vb === this.fitted) this.fit(); // a fit shown stays one: what it shows may change
+      else if (this.vb) this.setViewBox(this.vb);
     }).observe(host);
     bindPointer(this, handlers);
   }
@@ -106,12 +110,14 @@ export class GraphView {
 
   clear(message) {
     this.svg = null;
+    this.activePath = null; // another machine's: its first view is fitted on its own active state
     this.marks = null;
     this.stage = null;
     this.key = null;
     this.base = null;
     this.clusters = [];
     this.classed = new Map();
+    this._said("");
     this._emit("layout");
     const p = document.createElement("p");
     p.className = "graph-empty";
@@ -170,7 +176,10 @@ export class GraphView {
       if (!deepest || path.length > deepest.path.length) deepest = { path, el };
     }
     // Measured before anything is written, so reading the layout forces no style or layout.
-    const pan = this.follow && deepest ? this._panFor(deepest.el) : null;
+    let pan = this.follow && deepest ? this._panFor(deepest.el) : null;
+    // The first view of a machine too big to read whole: the fit made before its active state was known
+    // showed its top left; now it can show the active state's container.
+    const refit = deepest && !this.activePath && this.note && this.vb === this.fitted;
     if (deepest?.path !== this.activePath || view.selected !== this.selectedPath) {
       this.activePath = deepest?.path ?? null;
       this.selectedPath = view.selected;
@@ -187,7 +196,8 @@ export class GraphView {
     this._setClass("breakpoint", this._drawnIds(view.breakpoints));
     this._setClass("held", this._drawnIds(view.held));
     this.marks.show(new Set([...this.classed.values()].flatMap((ids) => [...ids])));
-    if (pan) this.setViewBox(pan);
+    if (refit) this.fit();
+    else if (pan) this.setViewBox(pan);
   }
 
   /** The ids of the elements standing for `paths` (each itself or its closest drawn ancestor). */
@@ -208,7 +218,7 @@ export class GraphView {
     if (!el || !rect || !this.vb) return;
     const box = this._box(el);
     const scale = this.scale() < READABLE_SCALE ? COMFORT_SCALE : this.scale();
-    this.setViewBox(viewAt(box.x + box.w / 2, box.y + box.h / 2, scale, rect.width, rect.height));
+    this.setViewBox(partView(box, scale, rect, this.inset));
   }
 
   /** An element's box in user space, measured once per drawing. */
@@ -225,6 +235,7 @@ export class GraphView {
     if (!view || !this.vb) return null;
     const box = this._box(el);
     const margin = 2 / this.scale();
+    view.h -= this.inset / this.scale(); // the part under the minimap is not in view
     if (box.w > view.w - 2 * margin || box.h > view.h - 2 * margin) return null;
     const inside = box.x >= view.x + margin && box.x + box.w <= view.x + view.w - margin
       && box.y >= view.y + margin && box.y + box.h <= view.y + view.h - margin;
@@ -262,13 +273,28 @@ export class GraphView {
   /**
    * Show the whole graph, never larger than MAX_FIT_SCALE (a tiny graph stays small) and never so
    * small that labels cannot be read (graph_fit.js); says what it shows ("graph:fit": a sentence, or
-   * "" for the whole graph).
+   * "" for the whole graph), until the view changes.
    */
   fit() {
     if (!this.base) return;
     const rect = this._hostSize();
     const { vb, note } = rect ? readableFit(this, rect) : { vb: { ...this.base }, note: "" };
     this.setViewBox(vb);
+    this.fitted = vb;
+    this._said(note);
+  }
+
+  /** Show the whole graph however small its labels get (the fit's note offers it). */
+  fitWhole() {
+    const rect = this._hostSize();
+    if (this.base && rect) this.setViewBox(fitView(this.base, rect.width, rect.height));
+  }
+
+  /** Tell what the view shows when it changes ("graph:fit": the fit's sentence, "" once the view is
+   * another than the fit's). */
+  _said(note) {
+    if (note === this.note) return;
+    this.note = note;
     this._emit("fit", note);
   }
 
@@ -325,6 +351,10 @@ export class GraphView {
    * only moved. */
   setViewBox(vb) {
     this.vb = vb;
+    if (vb !== this.fitted) {
+      this.fitted = null;
+      this._said("");
+    }
     const view = this.stage && this.visible();
     if (!view) return;
     const k = this.scale();

@@ -22,7 +22,8 @@ function clusterOf(g, path) {
 /**
  * The whole drawing, centred (at most MAX_FIT_SCALE, a small one at the top); when its labels would
  * be under READABLE_PX: the container of the selection (or of the active state), or, too big as well,
- * that state (or the drawing's top left) with labels of 13 px. `note` says which ("" for the whole).
+ * that state (or the drawing's top left) with labels of 13 px, kept clear of the host's bottom
+ * `g.inset` px (the minimap, shown while a part is). `note` says which ("" for the whole).
  * @param {DOMRect} rect the host's size
  * @returns {{vb: import("./graph_geometry.js").Box, note: string}}
  */
@@ -34,21 +35,25 @@ export function readableFit(g, rect) {
     if (whole > MAX_FIT_SCALE) vb.y = base.y - 8 / MAX_FIT_SCALE; // a small graph sits at the top
     return { vb, note: "" };
   }
-  const tiny = `the whole graph would have ${(whole * LABEL_PT).toFixed(1)} px labels (− zooms out)`;
+  const tiny = `the whole graph would have ${(whole * LABEL_PT).toFixed(1)} px labels`;
   const focus = g.selectedPath || g.activePath;
   const cluster = focus ? clusterOf(g, focus) : null;
-  const clusterScale = cluster ? fitScale(cluster.box, rect.width, rect.height) : 0;
+  const clusterScale = cluster ? Math.min(fitScale(cluster.box, rect.width, rect.height - g.inset), MAX_FIT_SCALE) : 0;
   if (cluster && clusterScale >= READABLE_SCALE) {
-    return { vb: fitView(cluster.box, rect.width, rect.height), note: `Fit shows ${nameOf(cluster.path)}: ${tiny}` };
+    return { vb: partView(cluster.box, clusterScale, rect, g.inset), note: `Fit shows ${nameOf(cluster.path)}: ${tiny}` };
   }
   const el = focus ? g.stateElement(focus) : null;
   if (!el) {
     const vb = { x: base.x - 8, y: base.y - 8, w: rect.width / COMFORT_SCALE, h: rect.height / COMFORT_SCALE };
     return { vb, note: `Fit shows the top left: ${tiny}` };
   }
-  const box = userBox(el, g.svg);
-  return { vb: viewAt(box.x + box.w / 2, box.y + box.h / 2, COMFORT_SCALE, rect.width, rect.height),
+  return { vb: partView(userBox(el, g.svg), COMFORT_SCALE, rect, g.inset),
     note: `Fit shows ${nameOf(g.pathOf.get(el.id) ?? focus)}: ${tiny}` };
+}
+
+/** The view box at `scale` that centres `box` in the part of the host above its bottom `inset` px. */
+export function partView(box, scale, rect, inset) {
+  return viewAt(box.x + box.w / 2, box.y + box.h / 2 + inset / 2 / scale, scale, rect.width, rect.height);
 }
 
 /** Where the elements standing for `path` and its ancestors are in the view before a re-layout: a

@@ -3,8 +3,8 @@
 
 /** @typedef {{x: number, y: number, w: number, h: number}} Box */
 
-// The nodes' labels are 11 pt (server/graph.py); under 9 px on screen they cannot be read.
-export const LABEL_PT = 11;
+// The nodes' labels are 12 pt (server/graph.py); under 9 px on screen they cannot be read.
+export const LABEL_PT = 12;
 export const READABLE_PX = 9;
 export const READABLE_SCALE = READABLE_PX / LABEL_PT; // px per SVG unit at which labels can be read
 export const COMFORT_SCALE = 13 / LABEL_PT; // the "readable" zoom: labels of 13 px

@@ -58,7 +58,7 @@ def assert_the_bar_keeps_its_controls_and_notice(page) -> None:
     for control in shown["controls"]:
         assert control["inView"] and control["uncovered"], shown
     assert shown["notice"]["inView"] and not shown["notice"]["clipped"], shown
-    assert shown["notice"]["width"] >= 140, shown  # it had 17 px: one letter
+    assert shown["notice"]["width"] >= 120, shown  # it had 17 px: one letter
 
 
 @pytest.mark.parametrize("size", [(1440, 900), (1920, 1080)], ids=["1440", "1920"])

@@ -12,12 +12,31 @@ import { debugLine } from "./transcript.js";
 const $ = (id) => document.getElementById(id);
 const BUTTONS = ["pause-btn", "resume-btn", "step-btn", "step-over-btn", "force-btn"];
 
+// Why a deadman paused the machine, for a pause hold whose words name it as who paused ("paused by
+// deadman"): the server's, when the page in control stopped beating (server/lease_control.py DEADMAN),
+// or a publishing process's or a fleet robot's own, when it lost the dashboard (DEADMAN_CLIENT of
+// server/publisher.py and fleet/control.py). `after`: the deadman's seconds (the lease's,
+// static/lease.js), when this page knows them.
+const lostTheDashboard = (after) => "its process lost its connection to the dashboard" + (after ? ` for ${after} s` : "");
+const DEADMAN_WHY = {
+  deadman: (after) => after ? `the page in control sent no heartbeat for ${after} s` : "the page in control stopped sending heartbeats",
+  publisher: lostTheDashboard,
+  robot: lostTheDashboard,
+};
+
+/** The words the banner adds to `hold`'s: why a deadman paused the machine; "" when none did. */
+function deadmanWhy(hold, after) {
+  const by = hold.reason === "pause" && hold.detail.startsWith("paused by ") ? hold.detail.slice("paused by ".length) : null;
+  return Object.hasOwn(DEADMAN_WHY, by) ? ` (${DEADMAN_WHY[by](after)})` : "";
+}
+
 /** What the banner says of a debugger's state `debug` ({mode, level, holds}): each hold, or the mode
- * when nothing holds yet; null when it runs free. */
-export function pausedText(debug) {
+ * when nothing holds yet; null when it runs free. `deadmanAfter`: the deadman's seconds, if known. */
+export function pausedText(debug, deadmanAfter = null) {
   if (!debug) return null;
   if (debug.holds.length) {
-    return "Paused " + debug.holds.map((hold) => `in ${hold.path}: ${debugLine({ action: "hold", ...hold }).text}`).join("; ");
+    return "Paused " + debug.holds.map((hold) =>
+      `in ${hold.path}: ${debugLine({ action: "hold", ...hold }).text}${deadmanWhy(hold, deadmanAfter)}`).join("; ");
   }
   return debug.mode === "run" ? null : debugLine({ action: "mode", mode: debug.mode, level: debug.level }).text;
 }
@@ -46,7 +65,7 @@ export class DebugBar {
   /** Show the debugger's state at the instant shown of `state` (the store's) and enable what the live
    * machine accepts now. */
   update(state) {
-    const text = pausedText(shownStatus(state)?.debug);
+    const text = pausedText(shownStatus(state)?.debug, state.lease?.deadman?.after);
     const bar = $("debug-bar");
     bar.hidden = text === null;
     const what = bar.querySelector(".debug-text");

@@ -67,7 +67,7 @@ export class DetailsPanel {
     this.body.replaceChildren(
       h("p", { class: "details-head" }, h("strong", { text: node.label }), " ", h("span", { class: "muted", text: node.type })),
       h("p", { class: "details-path", text: node.path }),
-      node.doc ? h("p", { class: "details-doc", text: node.doc }) : null,
+      node.doc ? h("p", { class: "details-doc", text: node.doc }) : h("p", { class: "details-no-doc muted", text: "no docstring" }),
       rows([
         ["outcomes", this._outcomes(node, parentNode)],
         ["input keys", this._keys(node.input_keys, node.remapping)],

@@ -17,6 +17,12 @@ const BLOCK_ROWS = 100;
 // half of a 600-state machine's frame at 1,000 events/s (bench/big_machine_browser.py).
 const MAX_ROWS_PER_FRAME = 40;
 const HIDDEN_AT_FIRST = new Set(["pose"]); // 30 a second: shown only when asked for
+// Only the user's own scrolling stops the log following the newest row: a scroll within this long of
+// their wheel, touch or scrolling key, or while they hold the pointer down (the scrollbar). A scroll
+// of the page's own lands short of the end when the blocks it scrolled past get their real heights
+// (style.css): taken for the user's, it stopped the log following after every search.
+const USER_SCROLL_MS = 400;
+const SCROLL_KEYS = new Set(["ArrowUp", "ArrowDown", "PageUp", "PageDown", "Home", "End", " "]);
 
 function selectionOf(ev) {
   const path = ev.path;
@@ -92,9 +98,7 @@ export class EventLog {
     this.needle = ""; // the text filter, lower case
     this.stick = true; // follow the newest row (false once the user scrolls up)
     this.scrollDue = false; // rows were drawn while following: followNewest() scrolls to them
-    host.addEventListener("scroll", () => {
-      this.stick = host.scrollHeight - host.scrollTop - host.clientHeight < 24;
-    }, { passive: true });
+    this._followUserScrolls(host);
     this.nodeOf = () => undefined;
     this.transcript = new Transcript((path) => this.nodeOf(path)); // fed every event in order
     this.selectedRow = null;
@@ -111,6 +115,30 @@ export class EventLog {
       this.selectedRow = row;
       this.handlers.select(row.dataset.select, Number(row.dataset.seq));
     });
+  }
+
+  /** Stop following when the user scrolls the log away from its end, follow again when they bring
+   * it back there (USER_SCROLL_MS). */
+  _followUserScrolls(host) {
+    let userAt = -Infinity; // when the user last scrolled by wheel, touch or key
+    let pointerDown = false;
+    const byUser = () => { userAt = performance.now(); };
+    host.addEventListener("wheel", byUser, { passive: true });
+    host.addEventListener("touchmove", byUser, { passive: true });
+    document.addEventListener("keydown", (e) => {
+      if (SCROLL_KEYS.has(e.key) && !e.target.closest?.("input, textarea, select")) byUser();
+    });
+    host.addEventListener("pointerdown", () => { pointerDown = true; });
+    for (const type of ["pointerup", "pointercancel"]) {
+      window.addEventListener(type, () => {
+        if (pointerDown) byUser();
+        pointerDown = false;
+      });
+    }
+    host.addEventListener("scroll", () => {
+      if (host.scrollHeight - host.scrollTop - host.clientHeight < 24) this.stick = true;
+      else if (pointerDown || performance.now() - userAt < USER_SCROLL_MS) this.stick = false;
+    }, { passive: true });
   }
 
   reset() {
@@ -237,9 +265,14 @@ export class EventLog {
     this._show(rows, "No events.");
     this._count();
     this.stick = true;
-    // To the newest row when the page is next laid out anyway (now would lay it all out once more).
-    requestAnimationFrame(() => {
+    // To the newest row when the page is next laid out anyway (now would lay it all out once more),
+    // and again at the frame after, when the rows then in view have their real heights (style.css).
+    const toNewest = () => {
       if (this.stick && !this.past) this.host.scrollTop = this.host.scrollHeight;
+    };
+    requestAnimationFrame(() => {
+      toNewest();
+      requestAnimationFrame(toNewest);
     });
   }
 

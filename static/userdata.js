@@ -89,12 +89,13 @@ export class UserdataPanel {
     for (const key of keys.sort()) {
       const value = ud[key];
       const open = this.expanded.has(key);
+      const change = Object.hasOwn(changes, key) && changedValue(changes[key]) ? changes[key] : null;
+      const note = change ? changeNote(change) : null;
+      // Collapsed, a key takes one line: its value cut to the pane's width, then what it was.
       const valueCell = open
-        ? h("td", { class: "value" }, h("pre", { text: JSON.stringify(value, null, 2) }))
-        : h("td", { class: "value", text: valueText(value, 160) });
+        ? h("td", { class: "value" }, h("pre", { text: JSON.stringify(value, null, 2) }), ...(note ? [note] : []))
+        : h("td", { class: "value" }, h("div", { class: "ud-line" }, h("span", { text: valueText(value, 160) }), ...(note ? [note] : [])));
       if (value && typeof value === "object" && ("$repr" in value || "$truncated" in value)) valueCell.classList.add("repr");
-      const change = Object.hasOwn(changes, key) ? changes[key] : null;
-      if (change) valueCell.append(changeNote(change));
       const historyButton = h("button", { type: "button", class: "ud-history-btn", "data-key": key, text: "history",
         title: "every change of " + key + " in this run, with the state that made it" });
       body.append(h("tr", { class: "ud-row" + (change ? " changed" : ""), "data-key": key, title: open ? "" : "click to expand" },
@@ -121,10 +122,16 @@ export class UserdataPanel {
   }
 }
 
-/** "was OLD" (or "new key") under a value its container's last transition changed. */
+/** Whether a key its container's last transition wrote (`change`: {old?, new}) has another value now:
+ * a state that writes a key again with the value it had changed nothing. */
+function changedValue(change) {
+  return !Object.hasOwn(change, "old") || JSON.stringify(change.old) !== JSON.stringify(change.new);
+}
+
+/** "was OLD" (or "new key") beside a value its container's last transition changed. */
 function changeNote(change) {
   const text = Object.hasOwn(change, "old") ? "was " + valueText(change.old, 80) : "new key";
-  return h("div", { class: "ud-change", text });
+  return h("span", { class: "ud-change", text, title: text });
 }
 
 /** Every change of `key` in `events` (one container's start, transition and userdata events, in

@@ -76,6 +76,7 @@ class Debugger:
         self.armed = False
         self.mode = "run"
         self.level: str | None = None  # a step's container: it ends at that container's next transition
+        self._paused_by: str | None = None  # who asked for the pause mode (None: a hold paused the machine)
         self._cond = threading.Condition()
         self._breakpoints: dict[str, tuple[Breakpoint, ...]] = {}
         self._forced: dict[str, tuple[str, str | None]] = {}  # state path: (outcome, by)
@@ -208,7 +209,7 @@ class Debugger:
             elif self.mode == "step" and (self.level is None or self.level == container._path):
                 reason, detail = "step", "stepped"
             elif self.mode == "pause":
-                reason, detail = "pause", "paused"
+                reason, detail = "pause", "paused by %s" % self._paused_by if self._paused_by else "paused"
             else:
                 return outcome
         hold = self._hold(container, label, "after", outcome, reason, detail)
@@ -265,6 +266,7 @@ class Debugger:
         if (mode, level) == (self.mode, self.level):
             return
         self.mode, self.level = mode, level
+        self._paused_by = by if mode == "pause" else None
         self._arm()
         self._emit(self.root_path, action="mode", mode=mode, level=level, by=by)
 

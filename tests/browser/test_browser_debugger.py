@@ -7,6 +7,7 @@ test_browser_debugger_demo.py)."""
 from __future__ import annotations
 
 import json
+import re
 import threading
 import time
 
@@ -184,7 +185,7 @@ def test_a_condition_with_markup_is_shown_as_text(rounds):
 
 def test_pause_holds_the_machine_and_resume_lets_it_run_on(rounds):
     rounds.click("#pause-btn")
-    assert banner_saying(rounds, "Paused in").endswith(": paused")
+    assert re.search(r": paused by 127\.0\.0\.1 \(operator, page [0-9a-f]+\)$", banner_saying(rounds, "Paused in"))
     assert rounds.is_disabled("#pause-btn")
     rounds.click("#resume-btn")
     rounds.wait_for_selector("#debug-bar", state="hidden")

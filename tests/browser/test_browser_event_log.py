@@ -120,3 +120,76 @@ def test_a_concurrence_that_serviced_a_preempt_shows_no_concurrent_outcomes_line
         rows = rows_shown(page)
     assert "log: Concurrence serviced preempt." in rows
     assert not [row for row in rows if "Concurrent Outcomes" in row], rows
+
+
+# Whether the log shows its newest row (its bottom in view), and that row's seq.
+NEWEST_IN_VIEW = """() => {
+  const log = document.getElementById('log');
+  const rows = log.querySelectorAll('.log-row');
+  const newest = rows[rows.length - 1];
+  if (!newest) return null;
+  const row = newest.getBoundingClientRect(), view = log.getBoundingClientRect();
+  return { seq: Number(newest.dataset.seq), inView: row.bottom <= view.bottom + 1 && row.top >= view.top - 1 };
+}"""
+
+
+def ticking(stop: threading.Event):
+    """A -> B -> A ... every 40 ms until ``stop`` is set."""
+    def tick(ud):
+        stop.wait(0.04)
+        return "stop" if stop.is_set() else "go"
+
+    sm = fsm.StateMachine(outcomes=["done"])
+    with sm:
+        fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["go", "stop"]), {"go": "B", "stop": "done"})
+        fsm.StateMachine.add("B", fsm.CBState(tick, outcomes=["go", "stop"]), {"go": "A", "stop": "done"})
+    return sm
+
+
+def assert_the_log_follows_the_newest_events(page, seconds: float = 3.0) -> None:
+    """For ``seconds``, each look finds the newest row in view, and newer rows keep coming."""
+    first = page.evaluate(NEWEST_IN_VIEW)["seq"]
+    for _ in range(int(seconds / 0.25)):
+        page.wait_for_timeout(250)
+        newest = page.evaluate(NEWEST_IN_VIEW)
+        assert newest["inView"], "the log stopped following at event %d" % newest["seq"]
+    assert newest["seq"] > first
+
+
+@pytest.fixture
+def ticking_page(browser):
+    """A page at 1440x900 watching `ticking` while it runs, its log holding more rows than it shows."""
+    stop = threading.Event()
+    sm = ticking(stop)
+    with served_page(browser, sm, "ticking") as page:
+        runner = threading.Thread(target=sm.execute)
+        runner.start()
+        try:
+            page.set_viewport_size({"width": 1440, "height": 900})
+            page.wait_for_function("() => document.getElementById('log').scrollHeight > 2 * document.getElementById('log').clientHeight")
+            yield page
+        finally:
+            stop.set()
+            runner.join(10)
+
+
+def test_the_log_follows_live_events_while_searching_and_once_the_search_is_cleared(ticking_page):
+    for search in ("'B'", "A", "transition"):
+        ticking_page.fill("#log-filter", search)
+        assert_the_log_follows_the_newest_events(ticking_page, 1.5)
+        ticking_page.fill("#log-filter", "")
+        assert_the_log_follows_the_newest_events(ticking_page)
+
+
+def test_scrolling_the_log_up_stops_following_and_scrolling_to_its_end_follows_again(ticking_page):
+    box = ticking_page.eval_on_selector("#log", "el => { const b = el.getBoundingClientRect(); return [b.x + b.width / 2, b.y + b.height / 2]; }")
+    ticking_page.mouse.move(*box)
+    ticking_page.mouse.wheel(0, -400)
+    ticking_page.wait_for_timeout(500)
+    held = ticking_page.eval_on_selector("#log", "el => el.scrollTop")
+    ticking_page.wait_for_timeout(1000)  # new rows come: the log stays where the user put it
+    assert ticking_page.eval_on_selector("#log", "el => el.scrollTop") == held
+    assert not ticking_page.evaluate(NEWEST_IN_VIEW)["inView"]
+    ticking_page.mouse.wheel(0, 100000)
+    ticking_page.wait_for_timeout(500)
+    assert_the_log_follows_the_newest_events(ticking_page)

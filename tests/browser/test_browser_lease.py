@@ -8,7 +8,7 @@ import threading
 
 import httpx
 import pytest
-from browser_support import served_page, watch
+from browser_support import banner_saying, served_page, watch
 from server.testing.browser import CHROMIUM, open_page
 from server.testing.demo_process import DemoProcess
 from server.testing.polling import wait_for
@@ -63,6 +63,16 @@ def test_a_second_page_sees_who_controls_and_can_take_control_over(loop_page, br
         assert not second.errors
     finally:
         second.close()
+
+
+def test_the_banner_says_the_deadman_paused_the_machine_and_why(loop_page, browser):
+    operator = watch(browser, loop_page.server, "loop")
+    operator.wait_for_selector(LEASE_PILL + ":not([hidden])")
+    operator.click("#lease-take")
+    wait_for(lambda: pill_text(operator) == "you control")
+    operator.close()  # its heartbeat stops: after the deadman's 3 s, the machine is paused
+    said = banner_saying(loop_page, "paused by deadman", timeout=10)
+    assert said.endswith("paused by deadman (the page in control sent no heartbeat for 3 s)")
 
 
 def test_the_audit_lists_each_control_with_who_held_control(loop_page):

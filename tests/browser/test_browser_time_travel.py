@@ -208,12 +208,26 @@ def test_playing_moves_the_instant_forward_through_the_recorded_states(browser, 
     page.close()
 
 
+def first_change(events, path: str, after: int) -> tuple[dict, str]:
+    """The first userdata event of container ``path`` after seq ``after`` that gives a key another value
+    (the demo's states write every output key, most with the value it had), and that key."""
+    values: dict = {}
+    for e in events:
+        if e["path"] == path and e["kind"] == "start":
+            values = dict(e["userdata"])
+        elif e["path"] == path and e["kind"] == "userdata":
+            for key, value in e["changes"].items():
+                if e["seq"] > after and (key not in values or values[key] != value):
+                    return e, key
+            values.update(e["changes"])
+    raise LookupError("no change of %s's userdata after %d" % (path, after))
+
+
 def test_the_userdata_a_transition_changed_shows_its_old_value(browser, replayed, events):
-    written = next(e for e in events if e["kind"] == "userdata" and e["path"] == "/SM_ROOT/TASK"
-                   and "cube_pose" in e["changes"] and e["seq"] > 10)
+    written, key = first_change(events, "/SM_ROOT/TASK", 10)
     page = open_at(browser, replayed[0], written["seq"])
     page.select_option("#ud-container", "/SM_ROOT/TASK")
-    row = page.wait_for_selector("#userdata tr.ud-row.changed[data-key='cube_pose']")
+    row = page.wait_for_selector("#userdata tr.ud-row.changed[data-key='%s']" % key)
     assert "was " in row.text_content() or "new key" in row.text_content()
     page.close()
 

@@ -75,6 +75,18 @@ def test_a_paused_machine_holds_the_next_transition_until_resumed(loop):
     assert run.join() == "done"
 
 
+def test_a_pause_hold_says_who_paused_the_machine(loop):
+    sm, a, b, debugger, events = loop
+    debugger.pause(by="deadman")
+    run = Background(sm.execute)
+    [hold] = held(debugger)
+    assert hold["detail"] == "paused by deadman"
+    a.stop.set()
+    b.stop.set()
+    debugger.resume()
+    assert run.join() == "done"
+
+
 def test_a_step_lets_exactly_one_transition_happen_and_holds_again(loop):
     sm, a, b, debugger, events = loop
     debugger.pause()

@@ -172,8 +172,9 @@ def test_a_hold_after_a_state_shows_in_the_userdata_panel_what_its_condition_saw
     banner_saying(rounds, "hit breakpoint after C")
     rounds.click('.tree-row[data-path="/SM_ROOT/C"] .label')  # its container's userdata
     assert rounds.input_value("#ud-container") == "/SM_ROOT"
-    value = rounds.locator('#userdata tr.ud-row[data-key="n"] td.value')
-    assert value.evaluate("td => td.firstChild.textContent") == str(target)  # then its change note: was n - 1
+    row = '#userdata tr.ud-row[data-key="n"]'
+    assert rounds.text_content(row + " .ud-line > span:first-child") == str(target)
+    assert rounds.text_content(row + " .ud-change") == "was %d" % (target - 1)
 
 
 def test_a_condition_with_markup_is_shown_as_text(rounds):

@@ -12,7 +12,7 @@ import server.timeline
 from server.testing.polling import wait_for
 from server.timeline import MANY, TimelineIndex
 from server_support import client, sleeper, waiting_machine
-from smach_support import concurrence, failing_machine, machine, run_to_failure
+from smach_support import Out, concurrence, failing_machine, machine, run_to_failure
 
 
 def served(srv, sm, name):
@@ -60,8 +60,24 @@ def test_the_bands_of_a_nested_machine_are_its_states_in_turn_at_every_level(liv
 
 
 def test_a_concurrence_shows_plus_while_several_children_run(live_server):
-    cc = concurrence(["done"], "done", [("FAST", sleeper(0.01)), ("SLOW", sleeper(0.05))],
-                     outcome_map={"done": {"FAST": "go", "SLOW": "go"}})
+    slow_began, fast_ended = threading.Event(), threading.Event()
+
+    def fast(ud):
+        slow_began.wait(10)  # both run at once, however the threads are scheduled
+        return "go"
+
+    def slow(ud):
+        slow_began.set()
+        fast_ended.wait(10)  # FAST ends first, however loaded the machine
+        return "go"
+
+    def reported(outcomes):
+        if outcomes["FAST"] is not None:
+            fast_ended.set()  # FAST's transition has been reported
+        return False
+
+    cc = concurrence(["done"], "done", [("FAST", Out(fast, outcomes=["go"])), ("SLOW", Out(slow, outcomes=["go"]))],
+                     outcome_map={"done": {"FAST": "go", "SLOW": "go"}}, child_termination_cb=reported)
     sm = machine(["done"], [("CC", cc, {"done": "done"})])
     served(live_server, sm, "together")
     sm.execute()

@@ -27,7 +27,7 @@ def main() -> int:
         try:
             with sync_playwright() as pw:
                 browser = launch_chromium(pw)
-                page = open_page(browser, demo.url, 1600, 900, timeout_ms=30000)
+                page = open_page(browser, demo.url, 1440, 900, timeout_ms=30000)
                 page.wait_for_selector("#scene-pane:not([hidden]) iframe")
                 scene = page.frame_locator("#scene-pane iframe")
                 scene.locator("canvas").first.wait_for(state="visible")

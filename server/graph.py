@@ -30,7 +30,7 @@ from fsm.observation.schema import container_id, edge_id, outcome_id, state_id
 from fsm.observation.visible import visible
 
 from .dot import DotError, DotPool
-from .graph_rows import EDGE_CHAR_PT, fit_score, node_size, ranks, row_choices
+from .graph_rows import fit_score, make_rows, row_options
 
 SVG_NS = "http://www.w3.org/2000/svg"
 XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -88,7 +88,7 @@ def described(node: dict) -> str:
 def build_dot(node: dict, sizes: dict[str, tuple[float, float]], per_row: int = 1) -> tuple[pydot.Dot, dict[str, str]]:
     """One container's graph, and the title of each element by id (dot would title them by its own
     node names, "n12"); ``sizes`` gives the drawing size (points) of each open child container;
-    ``per_row``: how many ranks of its states a row holds (``row_choices``; 1: dot's own column)."""
+    ``per_row``: how many ranks of its states a row holds (server/graph_rows.py; 1: dot's own column)."""
     path = node["path"]
     titles = {container_id(path): described(node)}
     g = pydot.Dot(q(path), graph_type="digraph")
@@ -132,7 +132,7 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]], per_row: int = 
     for outcome in node.get("outcomes") or ():
         outcome_node(outcome)
     outcome_set = set(outcome_nodes.values())
-    row_of = _rows(g, node, names, per_row)  # None: one rank a row
+    row_of = make_rows(g, node, names, per_row)  # None: one rank a row
     seen: dict[str, int] = {}
     for tr in node.get("transitions") or ():
         src = names.get(tr["from"])
@@ -164,49 +164,6 @@ def build_dot(node: dict, sizes: dict[str, tuple[float, float]], per_row: int = 
             sink.add_node(pydot.Node(name))
         g.add_subgraph(sink)
     return g, titles
-
-
-def _ranking(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[dict[str, int], dict[str, tuple[float, float]], dict[str, float]]:
-    """A container's states (by label): their ranks, estimated sizes and widest outgoing edge label."""
-    children = node.get("children") or ()
-    labels = {c["label"] for c in children}
-    edges, widest = [], {c["label"]: 0.0 for c in children}
-    for tr in node.get("transitions") or ():
-        if tr["from"] not in labels:
-            continue
-        widest[tr["from"]] = max(widest[tr["from"]], len(tr["outcome"]) * EDGE_CHAR_PT)
-        if tr.get("to") in labels:
-            edges.append((tr["from"], tr["to"]))
-    initial = [label for label in node.get("initial") or () if label in labels]
-    rank = ranks(list(widest), initial, edges)
-    return rank, {c["label"]: node_size(c["label"], sizes.get(c["path"])) for c in children}, widest
-
-
-def row_options(node: dict, sizes: dict[str, tuple[float, float]], count: int) -> list[int]:
-    """The ``count`` best estimated numbers of ranks a row of the container holds (server/graph_rows.py)."""
-    rank, boxes, widest = _ranking(node, sizes)
-    return row_choices(rank, boxes, widest, len(node.get("outcomes") or ()), count)
-
-
-def _rows(g: pydot.Dot, node: dict, names: dict[str, str], per_row: int) -> dict[str, int] | None:
-    """Wrap the container's states into rows of ``per_row`` ranks (server/graph_rows.py): each
-    state's row (by dot name), a row's first state kept under the one above it; None: no rows."""
-    if per_row <= 1:
-        return None
-    rank = {names[label]: r for label, r in _ranking(node, {})[0].items()}
-    g.set("ranksep", "0.25")  # the rows' edges are labelled beside them (below): no rank of labels between rows
-    row_of = {name: r // per_row for name, r in rank.items()}
-    heads = []
-    for row in range(max(row_of.values()) + 1):
-        band = pydot.Subgraph(rank="same")
-        members = sorted((name for name in row_of if row_of[name] == row), key=lambda name: rank[name])
-        for name in members:
-            band.add_node(pydot.Node(name))
-        g.add_subgraph(band)
-        heads.append(members[0])
-    for above, below in zip(heads, heads[1:]):  # the rows aligned on the left, as lines of text are
-        g.add_edge(pydot.Edge(above, below, style="invis", weight="10"))
-    return row_of
 
 
 _dot = DotPool(min(os.cpu_count() or 1, 8))

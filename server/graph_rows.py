@@ -6,11 +6,14 @@ container are ranked (a longest path from its initial state, loops left out) and
 are grouped into rows, each drawn left to right (a ``rank=same`` subgraph: dot lays a row's edges
 out as flat ones), the rows top to bottom like the lines of a text. How many ranks a row holds is
 chosen by the drawing's fit to a box of ASPECT (width / height, a landscape graph pane): the sizes
-of every choice are estimated here, and server/graph.py has dot lay the few best out and keeps the
-one that fits best (dot routes edges around rows as it likes). One rank a row is dot's own drawing.
+of every choice are estimated here, and the rows of a choice put into its dot graph (make_rows);
+server/graph.py has dot lay the few best out and keeps the one that fits best (dot routes edges
+around rows as it likes). One rank a row is dot's own drawing.
 """
 
 from __future__ import annotations
+
+import pydot
 
 ASPECT = 1.5  # width / height of the box a drawing is made to fit: the graph pane of a laptop's page
 CHAR_PT = 7.6  # a label's width per character (12 pt Times, mostly capitals)
@@ -87,3 +90,46 @@ def row_choices(rank: dict[str, int], sizes: dict[str, tuple[float, float]], fla
             height += OUTCOME_ROW_PT
         scored.append((-fit_score(width, height), k))
     return [k for _, k in sorted(scored)[:count]] or [1]
+
+
+def ranking(node: dict, sizes: dict[str, tuple[float, float]]) -> tuple[dict[str, int], dict[str, tuple[float, float]], dict[str, float]]:
+    """A container's states (by label): their ranks, estimated sizes and widest outgoing edge label."""
+    children = node.get("children") or ()
+    labels = {c["label"] for c in children}
+    edges, widest = [], {c["label"]: 0.0 for c in children}
+    for tr in node.get("transitions") or ():
+        if tr["from"] not in labels:
+            continue
+        widest[tr["from"]] = max(widest[tr["from"]], len(tr["outcome"]) * EDGE_CHAR_PT)
+        if tr.get("to") in labels:
+            edges.append((tr["from"], tr["to"]))
+    initial = [label for label in node.get("initial") or () if label in labels]
+    rank = ranks(list(widest), initial, edges)
+    return rank, {c["label"]: node_size(c["label"], sizes.get(c["path"])) for c in children}, widest
+
+
+def row_options(node: dict, sizes: dict[str, tuple[float, float]], count: int) -> list[int]:
+    """The ``count`` best estimated numbers of ranks a row of the container holds."""
+    rank, boxes, widest = ranking(node, sizes)
+    return row_choices(rank, boxes, widest, len(node.get("outcomes") or ()), count)
+
+
+def make_rows(g: pydot.Dot, node: dict, names: dict[str, str], per_row: int) -> dict[str, int] | None:
+    """Wrap the container's states into rows of ``per_row`` ranks in its graph ``g``: each
+    state's row (by dot name), a row's first state kept under the one above it; None: no rows."""
+    if per_row <= 1:
+        return None
+    rank = {names[label]: r for label, r in ranking(node, {})[0].items()}
+    g.set("ranksep", "0.25")  # the rows' edges are labelled beside them (below): no rank of labels between rows
+    row_of = {name: r // per_row for name, r in rank.items()}
+    heads = []
+    for row in range(max(row_of.values()) + 1):
+        band = pydot.Subgraph(rank="same")
+        members = sorted((name for name in row_of if row_of[name] == row), key=lambda name: rank[name])
+        for name in members:
+            band.add_node(pydot.Node(name))
+        g.add_subgraph(band)
+        heads.append(members[0])
+    for above, below in zip(heads, heads[1:]):  # the rows aligned on the left, as lines of text are
+        g.add_edge(pydot.Edge(above, below, style="invis", weight="10"))
+    return row_of

@@ -1,7 +1,7 @@
 // The machine graph, one piece on purpose: loading, marking and the view box all act on the same
 // inlined SVG, its element index and the boxes measured on it. The SVG is the server's Graphviz
-// drawing (one layout per structure + expand set), sanitized and inlined; status only toggles CSS classes on the stable ids of docs/api.md
-// (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
+// drawing (one layout per structure + expand set), sanitized and inlined; status only toggles CSS
+// classes on the stable ids of docs/api.md (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
 // the layout never moves when only the status changes; the marks are drawn by an overlay of copies
 // (graph_marks.js), so the drawing itself never repaints. Both lie on a stage the size of the drawing
 // at the scale shown: a pan (drag, Follow) moves the stage (a CSS transform, which Chromium composites

@@ -1,16 +1,17 @@
 // The machine graph, one piece on purpose: loading, marking and the view box all act on the same
 // inlined SVG, its element index and the boxes measured on it. The SVG is the server's Graphviz
 // drawing (one layout per structure + expand set), sanitized and inlined; status only toggles CSS
-// classes on the stable ids of docs/api.md (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME, escaped as static/schema.js says), so
-// the layout never moves when only the status changes; the marks are drawn by an overlay of copies
-// (graph_marks.js), so the drawing itself never repaints. Both lie on a stage the size of the drawing
-// at the scale shown: a pan (drag, Follow) moves the stage (a CSS transform, which Chromium composites
-// without laying out or painting the drawing again: changing the viewBox of a 600-state drawing laid
-// its text out again, 15 ms a frame), a zoom resizes it. `vb`, the view box shown, is the one
-// abstraction the rest of the page reads. A fit keeps labels readable (graph_geometry.js), a new
-// layout of the same machine can keep one element where it was on screen (semantic zoom). It tells
-// its host what changed ("graph:layout", "graph:view", "graph:focus", "graph:fit" events), which the
-// minimap and the breadcrumb (minimap.js, breadcrumb.js) follow; its pointer is graph_pointer.js's.
+// classes on the stable ids of docs/api.md (s:PATH, c:PATH, o:PATH:OUTCOME, e:PATH:FROM:OUTCOME,
+// escaped as static/schema.js says), so the layout never moves when only the status changes; the
+// marks are drawn by an overlay of copies (graph_marks.js), so the drawing itself never repaints.
+// Both lie on a stage the size of the drawing at the scale shown: a pan (drag, Follow) moves the
+// stage (a CSS transform, which Chromium composites without laying out or painting the drawing
+// again: changing the viewBox of a 600-state drawing laid its text out again, 15 ms a frame), a
+// zoom resizes it. `vb`, the view box shown, is the one abstraction the rest of the page reads. A
+// fit keeps labels readable (graph_geometry.js), a new layout of the same machine can keep one
+// element where it was on screen (semantic zoom). It tells its host what changed ("graph:layout",
+// "graph:view", "graph:focus", "graph:fit" events), which the minimap and the breadcrumb
+// (minimap.js, breadcrumb.js) follow; its pointer is graph_pointer.js's.
 
 import { anchorAfter, anchorBefore, partView, readableFit } from "./graph_fit.js";
 import { COMFORT_SCALE, READABLE_SCALE, ZOOM_STEP, clusterBoxes, fitView, userBox } from "./graph_geometry.js";

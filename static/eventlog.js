@@ -23,6 +23,7 @@ const HIDDEN_AT_FIRST = new Set(["pose"]); // 30 a second: shown only when asked
 // (style.css): taken for the user's, it stopped the log following after every search.
 const USER_SCROLL_MS = 400;
 const SCROLL_KEYS = new Set(["ArrowUp", "ArrowDown", "PageUp", "PageDown", "Home", "End", " "]);
+const UP_KEYS = new Set(["ArrowUp", "PageUp", "Home"]);
 
 function selectionOf(ev) {
   const path = ev.path;
@@ -123,10 +124,18 @@ export class EventLog {
     let userAt = -Infinity; // when the user last scrolled by wheel, touch or key
     let pointerDown = false;
     const byUser = () => { userAt = performance.now(); };
-    host.addEventListener("wheel", byUser, { passive: true });
+    // Up, when there is room above: the user leaves the end at once, however late (a loaded page)
+    // the scroll events of their wheel or key come.
+    const upByUser = () => {
+      byUser();
+      if (host.scrollTop > 0) this.stick = false;
+    };
+    host.addEventListener("wheel", (e) => (e.deltaY < 0 ? upByUser() : byUser()), { passive: true });
     host.addEventListener("touchmove", byUser, { passive: true });
     document.addEventListener("keydown", (e) => {
-      if (SCROLL_KEYS.has(e.key) && !e.target.closest?.("input, textarea, select")) byUser();
+      if (!SCROLL_KEYS.has(e.key) || e.target.closest?.("input, textarea, select")) return;
+      if (UP_KEYS.has(e.key) && host.contains(document.activeElement)) upByUser();
+      else byUser();
     });
     host.addEventListener("pointerdown", () => { pointerDown = true; });
     for (const type of ["pointerup", "pointercancel"]) {
@@ -135,9 +144,13 @@ export class EventLog {
         pointerDown = false;
       });
     }
+    let lastTop = host.scrollTop;
     host.addEventListener("scroll", () => {
-      if (host.scrollHeight - host.scrollTop - host.clientHeight < 24) this.stick = true;
-      else if (pointerDown || performance.now() - userAt < USER_SCROLL_MS) this.stick = false;
+      const up = host.scrollTop < lastTop; // the first steps of a scroll up may still be near the end
+      lastTop = host.scrollTop;
+      const byTheUser = pointerDown || performance.now() - userAt < USER_SCROLL_MS;
+      if (!up && host.scrollHeight - host.scrollTop - host.clientHeight < 24) this.stick = true;
+      else if (byTheUser) this.stick = false;
     }, { passive: true });
   }
 

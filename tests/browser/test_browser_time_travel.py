@@ -279,6 +279,10 @@ def live_page(browser):
 
 
 def look_back(page) -> int:
+    """Click the sixth row of the live log, scrolled up to with the wheel as a user does (the log follows
+    the newest row until the user scrolls it away: a row scrolled into view otherwise moves on)."""
+    page.hover("#log")
+    page.mouse.wheel(0, -100000)
     row = page.locator("#log .log-row[data-seq]").nth(5)
     seq = int(row.get_attribute("data-seq"))
     row.click()

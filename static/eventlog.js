@@ -165,7 +165,8 @@ export class EventLog {
    * the server no longer keeps the run's earliest events. */
   history({ complete, events }) {
     this.add(events);
-    this.redraw(); // all its rows at once, not only the newest of one frame
+    this.redraw(this.stick); // all its rows at once, not only the newest of one frame; a log the user
+    // scrolled away from its end (a resynchronisation after missed events) stays there
     const note = this.controls.partial;
     note.hidden = complete;
     if (!complete) {
@@ -264,8 +265,9 @@ export class EventLog {
     this.frozen = true;
   }
 
-  /** Draw again from the kept events, or the window looked back at (the filters or the events changed). */
-  redraw() {
+  /** Draw again from the kept events, or the window looked back at (the filters or the events changed);
+   * live, following the newest row unless `follow` is false. */
+  redraw(follow = true) {
     this.pending = [];
     this.needle = this.controls.text.value.trim().toLowerCase();
     if (this.past) {
@@ -277,7 +279,7 @@ export class EventLog {
     const rows = matching.slice(-MAX_ROWS).map((ev) => this._row(ev));
     this._show(rows, "No events.");
     this._count();
-    this.stick = true;
+    this.stick = follow;
     // To the newest row when the page is next laid out anyway (now would lay it all out once more),
     // and again at the frame after, when the rows then in view have their real heights (style.css).
     const toNewest = () => {

@@ -3,6 +3,7 @@
 
 import { clockText } from "./clocktext.js";
 import { h } from "./dom.js";
+import { followUserScrolls } from "./log_follow.js";
 import { KINDS } from "./schema.js";
 import { Transcript } from "./transcript.js";
 
@@ -17,13 +18,6 @@ const BLOCK_ROWS = 100;
 // half of a 600-state machine's frame at 1,000 events/s (bench/big_machine_browser.py).
 const MAX_ROWS_PER_FRAME = 40;
 const HIDDEN_AT_FIRST = new Set(["pose"]); // 30 a second: shown only when asked for
-// Only the user's own scrolling stops the log following the newest row: a scroll within this long of
-// their wheel, touch or scrolling key, or while they hold the pointer down (the scrollbar). A scroll
-// of the page's own lands short of the end when the blocks it scrolled past get their real heights
-// (style.css): taken for the user's, it stopped the log following after every search.
-const USER_SCROLL_MS = 400;
-const SCROLL_KEYS = new Set(["ArrowUp", "ArrowDown", "PageUp", "PageDown", "Home", "End", " "]);
-const UP_KEYS = new Set(["ArrowUp", "PageUp", "Home"]);
 
 function selectionOf(ev) {
   const path = ev.path;
@@ -99,7 +93,7 @@ export class EventLog {
     this.needle = ""; // the text filter, lower case
     this.stick = true; // follow the newest row (false once the user scrolls up)
     this.scrollDue = false; // rows were drawn while following: followNewest() scrolls to them
-    this._followUserScrolls(host);
+    followUserScrolls(host, (stick) => { this.stick = stick; });
     this.nodeOf = () => undefined;
     this.transcript = new Transcript((path) => this.nodeOf(path)); // fed every event in order
     this.selectedRow = null;
@@ -116,42 +110,6 @@ export class EventLog {
       this.selectedRow = row;
       this.handlers.select(row.dataset.select, Number(row.dataset.seq));
     });
-  }
-
-  /** Stop following when the user scrolls the log away from its end, follow again when they bring
-   * it back there (USER_SCROLL_MS). */
-  _followUserScrolls(host) {
-    let userAt = -Infinity; // when the user last scrolled by wheel, touch or key
-    let pointerDown = false;
-    const byUser = () => { userAt = performance.now(); };
-    // Up, when there is room above: the user leaves the end at once, however late (a loaded page)
-    // the scroll events of their wheel or key come.
-    const upByUser = () => {
-      byUser();
-      if (host.scrollTop > 0) this.stick = false;
-    };
-    host.addEventListener("wheel", (e) => (e.deltaY < 0 ? upByUser() : byUser()), { passive: true });
-    host.addEventListener("touchmove", byUser, { passive: true });
-    document.addEventListener("keydown", (e) => {
-      if (!SCROLL_KEYS.has(e.key) || e.target.closest?.("input, textarea, select")) return;
-      if (UP_KEYS.has(e.key) && host.contains(document.activeElement)) upByUser();
-      else byUser();
-    });
-    host.addEventListener("pointerdown", () => { pointerDown = true; });
-    for (const type of ["pointerup", "pointercancel"]) {
-      window.addEventListener(type, () => {
-        if (pointerDown) byUser();
-        pointerDown = false;
-      });
-    }
-    let lastTop = host.scrollTop;
-    host.addEventListener("scroll", () => {
-      const up = host.scrollTop < lastTop; // the first steps of a scroll up may still be near the end
-      lastTop = host.scrollTop;
-      const byTheUser = pointerDown || performance.now() - userAt < USER_SCROLL_MS;
-      if (!up && host.scrollHeight - host.scrollTop - host.clientHeight < 24) this.stick = true;
-      else if (byTheUser) this.stick = false;
-    }, { passive: true });
   }
 
   reset() {

@@ -14,12 +14,21 @@ const UP_KEYS = new Set(["ArrowUp", "PageUp", "Home"]);
 export function followUserScrolls(host, setStick) {
   let userAt = -Infinity; // when the user last scrolled by wheel, touch or key
   let pointerDown = false;
-  const byUser = () => { userAt = performance.now(); };
+  // The user went up with a wheel or a key: no scroll reaching the end follows again until they go
+  // down (a scroll event of the page's own, dispatched after their wheel, once did).
+  let leftByUser = false;
+  const byUser = () => {
+    userAt = performance.now();
+    leftByUser = false;
+  };
   // Up, when there is room above: the user leaves the end at once, however late (a loaded page)
   // the scroll events of their wheel or key come.
   const upByUser = () => {
-    byUser();
-    if (host.scrollTop > 0) setStick(false);
+    userAt = performance.now();
+    if (host.scrollTop > 0) {
+      leftByUser = true;
+      setStick(false);
+    }
   };
   host.addEventListener("wheel", (e) => (e.deltaY < 0 ? upByUser() : byUser()), { passive: true });
   host.addEventListener("touchmove", byUser, { passive: true });
@@ -28,7 +37,10 @@ export function followUserScrolls(host, setStick) {
     if (UP_KEYS.has(e.key) && host.contains(document.activeElement)) upByUser();
     else byUser();
   });
-  host.addEventListener("pointerdown", () => { pointerDown = true; });
+  host.addEventListener("pointerdown", () => {
+    pointerDown = true;
+    leftByUser = false;
+  });
   for (const type of ["pointerup", "pointercancel"]) {
     window.addEventListener(type, () => {
       if (pointerDown) byUser();
@@ -40,7 +52,7 @@ export function followUserScrolls(host, setStick) {
     const up = host.scrollTop < lastTop; // the first steps of a scroll up may still be near the end
     lastTop = host.scrollTop;
     const byTheUser = pointerDown || performance.now() - userAt < USER_SCROLL_MS;
-    if (!up && host.scrollHeight - host.scrollTop - host.clientHeight < 24) setStick(true);
+    if (!up && !leftByUser && host.scrollHeight - host.scrollTop - host.clientHeight < 24) setStick(true);
     else if (byTheUser) setStick(false);
   }, { passive: true });
 }

@@ -23,10 +23,10 @@ from pathlib import Path
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from fsm.logfiles.log_reader import read_events  # noqa: E402
-from interop.bag_reader import read_bag  # noqa: E402
-from interop.smach_events import events  # noqa: E402
-from interop.testing import wide_run, write_bag  # noqa: E402
-from interop.to_log import write_log  # noqa: E402
+from fsmscope.interop.bag_reader import read_bag  # noqa: E402
+from fsmscope.interop.smach_events import events  # noqa: E402
+from fsmscope.interop.testing import wide_run, write_bag  # noqa: E402
+from fsmscope.interop.to_log import write_log  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 REPEATS = 3

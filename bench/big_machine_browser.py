@@ -1,6 +1,6 @@
 """Big machines in the page (issue 11), measured in real Chromium (Debian's); a table against the targets:
 
-- follow: a 600-state machine (server/testing/big_machine.py: 40 containers, 560 leaves, Concurrences)
+- follow: a 600-state machine (fsmscope/server/testing/big_machine.py: 40 containers, 560 leaves, Concurrences)
   drawn fully open, running at ~1,000 events/s, the page following the active state: the share of
   the time the page's main thread spends in long tasks (PerformanceObserver "longtask": tasks over
   50 ms) <= 20 %, and the longest gap between two frames (requestAnimationFrame) <= 100 ms; medians
@@ -12,7 +12,7 @@
 - semantic zoom: the 600-state machine as the page opens it ("auto": semantic zoom), Follow on:
   from semantic zoom asking for another set of open containers to its drawing in the page <= 300 ms
   (the median of every re-layout of the rounds; the slowest is shown too), and how many containers Graphviz laid out for
-  each (server/graph.py lays out only the containers that opened or closed and their ancestors; the
+  each (fsmscope/server/graph.py lays out only the containers that opened or closed and their ancestors; the
   rest comes from its cache).
 
 The machines run in this process, served by a real uvicorn on a free port (server.http_server), as a
@@ -35,10 +35,10 @@ sys.path.insert(0, ROOT)
 
 import fsm  # noqa: E402
 from quiet_page import QuietPage  # noqa: E402
-from server import graph  # noqa: E402
-from server.http_server import ServerThread  # noqa: E402
-from server.testing.big_machine import big_machine, count_states  # noqa: E402
-from server.testing.browser import launch_chromium  # noqa: E402
+from fsmscope.server import graph  # noqa: E402
+from fsmscope.server.http_server import ServerThread  # noqa: E402
+from fsmscope.server.testing.big_machine import big_machine, count_states  # noqa: E402
+from fsmscope.server.testing.browser import launch_chromium  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 RATE = 1000  # events/s the running machine is paced to

@@ -24,8 +24,8 @@ from pathlib import Path
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
-from server.testing.demo_process import FSMSCOPE, DemoProcess  # noqa: E402
-from server.testing.polling import wait_for  # noqa: E402
+from fsmscope.server.testing.demo_process import FSMSCOPE, DemoProcess  # noqa: E402
+from fsmscope.server.testing.polling import wait_for  # noqa: E402
 
 TICKS = os.sysconf("SC_CLK_TCK")
 WARM_UP = 3.0  # seconds: start-up is not the steady state
@@ -79,7 +79,7 @@ def measure(start, seconds: float, browser: bool) -> tuple[float, float]:
             else:
                 from playwright.sync_api import sync_playwright
 
-                from server.testing.browser import launch_chromium, open_page
+                from fsmscope.server.testing.browser import launch_chromium, open_page
 
                 with sync_playwright() as pw:
                     chromium = launch_chromium(pw)

@@ -2,9 +2,9 @@
 1440 x 900 and 1920 x 1080: how many of the states' and open containers' labels a new page shows
 in its graph pane, clear of the minimap, and how big the smallest of them is on screen.
 
-- the demo's pick-and-place machine (sim/task.py, 19 states, not run), a 31-state mission and a
-  sequence of 30 steps (server/testing/mission.py): target every label shown, none under 9 px;
-- a 600-state machine, running (server/testing/big_machine.py: semantic zoom): target its active
+- the demo's pick-and-place machine (fsmscope/sim/task.py, 19 states, not run), a 31-state mission and a
+  sequence of 30 steps (fsmscope/server/testing/mission.py): target every label shown, none under 9 px;
+- a 600-state machine, running (fsmscope/server/testing/big_machine.py: semantic zoom): target its active
   state shown, no label shown under 9 px.
 
 The machines are served by a real uvicorn on a free port (server.http_server). Run it under the
@@ -22,10 +22,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, ROOT)
 
 import fsm  # noqa: E402
-from server.http_server import ServerThread  # noqa: E402
-from server.testing.big_machine import big_machine  # noqa: E402
-from server.testing.browser import launch_chromium, open_page  # noqa: E402
-from server.testing.mission import mission_machine, sequence_machine  # noqa: E402
+from fsmscope.server.http_server import ServerThread  # noqa: E402
+from fsmscope.server.testing.big_machine import big_machine  # noqa: E402
+from fsmscope.server.testing.browser import launch_chromium, open_page  # noqa: E402
+from fsmscope.server.testing.mission import mission_machine, sequence_machine  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 SCREENS = [(1440, 900), (1920, 1080)]
@@ -47,8 +47,8 @@ FIRST_VIEW = """() => {
 
 
 def demo_machine():
-    from sim.task import build_task_machine
-    from sim.world import World
+    from fsmscope.sim.task import build_task_machine
+    from fsmscope.sim.world import World
 
     return build_task_machine(World())
 

@@ -32,14 +32,14 @@ from typing import Callable
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 sys.path.insert(0, ROOT)
 
-import fleet.robot  # noqa: E402
+import fsmscope.fleet.robot  # noqa: E402
 import fsm  # noqa: E402
 import runtime  # noqa: E402
-from fleet.robot import ZenohRobot  # noqa: E402
+from fsmscope.fleet.robot import ZenohRobot  # noqa: E402
 from runtime import two_state_loop  # noqa: E402
-from server.cli.zenoh_options import robot_follows  # noqa: E402
-from server.http_server import ServerThread  # noqa: E402
-from server.testing.demo_process import free_endpoint  # noqa: E402
+from fsmscope.server.cli.zenoh_options import robot_follows  # noqa: E402
+from fsmscope.server.http_server import ServerThread  # noqa: E402
+from fsmscope.server.testing.demo_process import free_endpoint  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 BURNER = """
@@ -55,7 +55,7 @@ while True:
 
 WATCHER = """
 import sys, threading
-from fleet.watcher import FleetWatcher
+from fsmscope.fleet.watcher import FleetWatcher
 seen = [0]
 def count(events):
     seen[0] += len(events)
@@ -76,7 +76,7 @@ def prepared(srv: ServerThread, robot: ZenohRobot | None, joining: float = JOINI
     here, in every case alike, so that the timed run is that of a machine being followed."""
     sm, run = two_state_loop()
     entry = srv.hub.add_local(sm, name="loop-%d" % time.monotonic_ns())
-    if robot is not None:  # as `fsmscope run --zenoh` composes them (server/cli/fleet_bridge.py)
+    if robot is not None:  # as `fsmscope run --zenoh` composes them (fsmscope/server/cli/fleet_bridge.py)
         robot_follows(robot, entry)
     timed, runtime.LOOP_TRANSITIONS = runtime.LOOP_TRANSITIONS, WARM_UP
     try:

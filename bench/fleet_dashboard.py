@@ -30,7 +30,7 @@ import time
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
 sys.path.insert(0, ROOT)
 
-from server.testing.demo_process import free_endpoint  # noqa: E402
+from fsmscope.server.testing.demo_process import free_endpoint  # noqa: E402
 from quiet_page import QuietPage  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
@@ -74,7 +74,7 @@ PAGE_WINDOW = """
 def robot(name: str, connect: str) -> None:
     """A robot process: ``MACHINES`` machines, each A -> B -> A ... one transition every 1/RATE s."""
     import fsm
-    from fleet.robot import ZenohRobot
+    from fsmscope.fleet.robot import ZenohRobot
 
     fsm.set_loggers(*[lambda msg: None] * 4)
     published = ZenohRobot(name, connect=[connect], token="bench")
@@ -124,11 +124,11 @@ def main() -> None:
         return
     from playwright.sync_api import sync_playwright
 
-    from server.testing.browser import launch_chromium
+    from fsmscope.server.testing.browser import launch_chromium
 
     endpoint = free_endpoint()
     env = dict(os.environ, PYTHONPATH=ROOT)
-    dash = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh", "--zenoh-listen",
+    dash = subprocess.Popen([sys.executable, "-m", "fsmscope", "serve", "--port", "0", "--zenoh", "--zenoh-listen",
                              endpoint, "--zenoh-token", "bench"], cwd=ROOT, stderr=subprocess.PIPE, text=True, env=env)
     robots: list[subprocess.Popen] = []
     try:

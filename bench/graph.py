@@ -1,4 +1,4 @@
-"""Graph layout time (server/graph.py) for machines of 10, 100 and 1,000 states: cold and cached, medians.
+"""Graph layout time (fsmscope/server/graph.py) for machines of 10, 100 and 1,000 states: cold and cached, medians.
 
     .venv/bin/python bench/graph.py [--repeat 3]
 
@@ -17,8 +17,8 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from fsm.observation import structure  # noqa: E402
-from server import graph  # noqa: E402
-from server.hub import structure_hash  # noqa: E402
+from fsmscope.server import graph  # noqa: E402
+from fsmscope.server.hub import structure_hash  # noqa: E402
 
 
 def leaf(parent, label):

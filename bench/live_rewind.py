@@ -44,7 +44,7 @@ sys.path.insert(0, ROOT)
 
 from demo_cpu import TICKS, cpu_seconds  # noqa: E402
 from quiet_page import QuietPage  # noqa: E402
-from server.testing.browser import launch_chromium  # noqa: E402
+from fsmscope.server.testing.browser import launch_chromium  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 from replay import generate  # noqa: E402  (bench/replay.py: the two-state loop, recorded)
 from timetravel_browser import axis, page_of, served  # noqa: E402

@@ -18,7 +18,7 @@ import time
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 from fsm.logfiles.log_reader import read_events  # noqa: E402
-from interop.mcap_log import read_mcap, write_mcap  # noqa: E402
+from fsmscope.interop.mcap_log import read_mcap, write_mcap  # noqa: E402
 from replay import generate  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 

@@ -20,7 +20,7 @@ from typing import Any
 CATCH_ERRORS = """window.__quietErrors = [];
 addEventListener("error", (e) => window.__quietErrors.push(String(e.error || e.message)));
 addEventListener("unhandledrejection", (e) => window.__quietErrors.push(String(e.reason)));"""
-# Keys ``press`` knows, as Playwright's keyboard sends them (static/*.js read e.key).
+# Keys ``press`` knows, as Playwright's keyboard sends them (fsmscope/static/*.js read e.key).
 KEYS = {"Space": {"key": " ", "code": "Space", "windowsVirtualKeyCode": 32, "text": " "}}
 
 

@@ -26,8 +26,8 @@ sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 import fsm  # noqa: E402
 from fsm.observation.encoding import dumps  # noqa: E402
 from fsm.observation.schema import build  # noqa: E402
-from server.http_server import ServerThread  # noqa: E402
-from server.testing.clients import stalled_stream  # noqa: E402  (the stalled browser of the tests)
+from fsmscope.server.http_server import ServerThread  # noqa: E402
+from fsmscope.server.testing.clients import stalled_stream  # noqa: E402  (the stalled browser of the tests)
 
 
 def rss_mb():

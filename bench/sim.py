@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 
 import fsm  # noqa: E402
 from fsm.ros.bus import Bus  # noqa: E402
-from sim.world import HOME_Q, World  # noqa: E402
+from fsmscope.sim.world import HOME_Q, World  # noqa: E402
 
 RUNS = 5
 
@@ -52,7 +52,7 @@ def bench_world_steps(n: int = 20000) -> float:
 
 
 def bench_episode(seed: int) -> tuple[float, str]:
-    from sim.demo import SimDemo
+    from fsmscope.sim.demo import SimDemo
 
     d = SimDemo(seed=seed, fast=True, scene=False, bus=Bus())
     try:
@@ -69,7 +69,7 @@ def bench_cpu(window: float, scene: bool, always: bool) -> float:
     sc = None
     try:
         if scene:
-            from sim.scene import start_scene
+            from fsmscope.sim.scene import start_scene
 
             sc = start_scene(w, always=always)
         time.sleep(0.5)

@@ -34,11 +34,11 @@ from fsm.logfiles.log_reader import read_events  # noqa: E402
 from replay import REPEATS, generate, median_time  # noqa: E402  (bench/replay.py's 1M-event recording)
 import table  # noqa: E402
 from table import verdict  # noqa: E402
-from server.feed import Feed  # noqa: E402
-from server.history import History  # noqa: E402
-from server.log_history import LogHistory  # noqa: E402
-from server.http_server import ServerThread  # noqa: E402
-from server.timeline import TimelineIndex  # noqa: E402
+from fsmscope.server.feed import Feed  # noqa: E402
+from fsmscope.server.history import History  # noqa: E402
+from fsmscope.server.log_history import LogHistory  # noqa: E402
+from fsmscope.server.http_server import ServerThread  # noqa: E402
+from fsmscope.server.timeline import TimelineIndex  # noqa: E402
 
 MACHINE = "loop"  # the name bench/replay.py's generate records under
 

@@ -45,9 +45,9 @@ import fsm  # noqa: E402
 from fsm.logfiles.recorder import Recorder  # noqa: E402
 from quiet_page import QuietPage  # noqa: E402
 from replay import generate  # noqa: E402  (bench/replay.py: the two-state loop, recorded)
-from server.testing.browser import launch_chromium  # noqa: E402
-from server.testing.demo_process import FSMSCOPE  # noqa: E402
-from server.testing.polling import wait_for  # noqa: E402
+from fsmscope.server.testing.browser import launch_chromium  # noqa: E402
+from fsmscope.server.testing.demo_process import FSMSCOPE  # noqa: E402
+from fsmscope.server.testing.polling import wait_for  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 
 SEEKS = 20  # instants of the 1M-event run

@@ -13,8 +13,8 @@ from pathlib import Path
 
 from playwright.sync_api import sync_playwright
 
-from server.testing.browser import launch_chromium, open_page
-from server.testing.demo_process import DemoProcess
+from fsmscope.server.testing.browser import launch_chromium, open_page
+from fsmscope.server.testing.demo_process import DemoProcess
 
 OUT = Path(__file__).resolve().parent / "demo.png"
 # Mid-episode: the arm carries the cube.

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from interop.testing import write_bag as write
+from fsmscope.interop.testing import write_bag as write
 
 T0 = 1_700_000_000.0
 ROOT, GRASP, PLACE = "/SM_ROOT", "/SM_ROOT/GRASP", "/SM_ROOT/PLACE"

@@ -16,9 +16,9 @@ from pathlib import Path
 
 import fsm
 import httpx
-from server.testing.browser import open_page
-from server.http_server import ServerThread
-from server.testing.polling import wait_for
+from fsmscope.server.testing.browser import open_page
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
 # The id of the deepest state the graph highlights as active (a JavaScript expression), or null.
@@ -28,7 +28,7 @@ ACTIVE_LEAF = """(() => {
     return ids[0] || null;
 })()"""
 
-# A computed style of the first shape of the overlay's copy of a drawing element (static/graph_marks.js:
+# A computed style of the first shape of the overlay's copy of a drawing element (fsmscope/static/graph_marks.js:
 # the marks are drawn there), the copy found by its shape lying over the element's; null when none does.
 _MARK_STYLE = """([id, property]) => {
     const shape = (g) => g.querySelector(':scope > :is(ellipse, polygon, path)');
@@ -134,7 +134,7 @@ def watching(browser, server, machine: str, ready: str | None = None):
 
 def scene_client(scene, page) -> int:
     """The viser client of ``page``'s 3D view (``scene``: the sim.scene.Scene it shows): the one that
-    connected with the view id in the address of the page's frame (static/scene.js)."""
+    connected with the view id in the address of the page's frame (fsmscope/static/scene.js)."""
     view = page.eval_on_selector("#scene-pane iframe",
                                  "f => new URL(new URL(f.src).searchParams.get('websocket')).pathname.split('/').pop()")
     return wait_for(lambda: [c for c, v in scene.clients().items() if v == view], timeout=30,

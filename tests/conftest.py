@@ -81,7 +81,7 @@ def live_server():
 
     Yields the ServerThread: ``.hub``, ``.base_url`` (http://127.0.0.1:PORT), ``.port``, ``.token``.
     """
-    from server.http_server import ServerThread
+    from fsmscope.server.http_server import ServerThread
 
     srv = ServerThread().start()
     try:
@@ -103,7 +103,7 @@ def chromium():
     """Debian's Chromium, one process for the session (see ``browser``); skips when it, Playwright or
     Graphviz (the server draws the graph with dot) is missing. Playwright is imported here, not at
     collection."""
-    from server.testing.browser import CHROMIUM, CHROMIUM_ARGS
+    from fsmscope.server.testing.browser import CHROMIUM, CHROMIUM_ARGS
 
     playwright_api = pytest.importorskip("playwright.sync_api")
     if not os.path.exists(CHROMIUM):
@@ -159,7 +159,7 @@ def headless_demo_log(tmp_path_factory):
         recorded = shared / "headless-demo.recorded"  # touched once the log is whole: a failed one is recorded again
         if not recorded.exists():
             path.unlink(missing_ok=True)
-            done = subprocess.run([sys.executable, "-m", "server.cli", "demo", "--headless", "--episodes", "1",
+            done = subprocess.run([sys.executable, "-m", "fsmscope", "demo", "--headless", "--episodes", "1",
                                    "--record", str(path)], cwd=TESTS.parent,
                                   capture_output=True, text=True, timeout=240)
             assert done.returncode == 0, done.stdout + done.stderr

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import httpx
 from browser_support import page_at
-from server.testing.demo_process import DemoProcess
-from server.testing.polling import wait_for
+from fsmscope.server.testing.demo_process import DemoProcess
+from fsmscope.server.testing.polling import wait_for
 
 DEMO_MACHINE = "pick_place"
 FRESH_EPISODE = 1.5  # s: an episode (about 6 s at real time) begun this recently has seconds of it ahead

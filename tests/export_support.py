@@ -11,7 +11,7 @@ import pytest
 from recording_support import record
 from smach_support import machine
 
-from server import export_html
+from fsmscope.server import export_html
 
 LOOPS = 60
 MARKUP = '<img src=x onerror="window.pwned = 1"><b>bold</b> </script><script>window.pwned = 2</script>'

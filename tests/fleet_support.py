@@ -19,11 +19,11 @@ from pathlib import Path
 import fsm
 import httpx
 
-from fleet.watcher import FleetWatcher
+from fsmscope.fleet.watcher import FleetWatcher
 from fsm.logfiles.log_reader import read_events
 from fsm.observation.status import Status
-from server.testing.demo_process import free_endpoint
-from server.testing.polling import wait_for
+from fsmscope.server.testing.demo_process import free_endpoint
+from fsmscope.server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
 PATROL = Path(__file__).resolve().parent / "robots" / "patrol.py"
@@ -142,7 +142,7 @@ class Proxy:
 def started(command: list[str], said: str) -> tuple[subprocess.Popen, re.Match]:
     """``fsmscope COMMAND`` in a real process of its own group, once its stderr has said ``said`` (a
     pattern): the process and the match. Its stderr is read on after, so it never blocks on a full pipe."""
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", *command], cwd=ROOT, stderr=subprocess.PIPE,
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", *command], cwd=ROOT, stderr=subprocess.PIPE,
                             text=True, start_new_session=True)
     for line in proc.stderr:
         found = re.search(said, line)
@@ -207,7 +207,7 @@ class Robot:
 
     def start(self) -> None:
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "server.cli", "run", str(PATROL), "--no-serve", "--record", str(self.log), "--append",
+            [sys.executable, "-m", "fsmscope", "run", str(PATROL), "--no-serve", "--record", str(self.log), "--append",
              "--zenoh", self.name, "--zenoh-connect", self.endpoint, "--zenoh-token", self.token, *self.options,
              *(["--", "fail"] if self.fail else [])],
             cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)

@@ -12,13 +12,13 @@ import textwrap
 
 import pytest
 from browser_support import ROOT
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from server_support import client
 
 ONCE_SCRIPT = textwrap.dedent("""
     import sys, time
     import fsm as smach
-    from server.publisher import Publisher
+    from fsmscope.server.publisher import Publisher
 
     def step(ud):
         time.sleep(float(sys.argv[3]))
@@ -48,7 +48,7 @@ def remote(srv) -> dict | None:
 LOOP_SCRIPT = textwrap.dedent("""
     import sys, time
     import fsm as smach
-    from server.publisher import Publisher
+    from fsmscope.server.publisher import Publisher
 
     class Tick(smach.State):
         # Counts in userdata n; services a preempt; 'stop' only when forced.

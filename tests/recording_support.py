@@ -43,7 +43,7 @@ def cli(*args, cwd=None, env=None, timeout=60, memory=None):
 
     def limited():
         resource.setrlimit(resource.RLIMIT_AS, (memory, memory))
-    return subprocess.run([sys.executable, "-m", "server.cli", *map(str, args)], cwd=cwd or ROOT, env=full_env,
+    return subprocess.run([sys.executable, "-m", "fsmscope", *map(str, args)], cwd=cwd or ROOT, env=full_env,
                           capture_output=True, text=True, timeout=timeout, preexec_fn=memory and limited)
 
 
@@ -51,7 +51,7 @@ def cli(*args, cwd=None, env=None, timeout=60, memory=None):
 def replay_served(log, *args):
     """``fsmscope replay LOG --serve ARGS`` in a real process: yields (the address it printed, token
     included; the stderr lines before it); ended with Ctrl-C, as a user would, which exits 0."""
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(log), "--serve", *map(str, args)],
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "replay", str(log), "--serve", *map(str, args)],
                             cwd=ROOT, stderr=subprocess.PIPE, text=True, start_new_session=True,
                             env={**os.environ, "PYTHONFAULTHANDLER": "1"})  # SIGABRT: every thread's stack
     later: list[str] = []

@@ -1,5 +1,5 @@
 """A page's frame of the 3D view without a browser: a real viser websocket client, connected with a
-view id the way static/scene.js makes viser's page connect (ws://HOST:PORT/view/ID)."""
+view id the way fsmscope/static/scene.js makes viser's page connect (ws://HOST:PORT/view/ID)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import threading
 
 import msgspec
 import viser
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from websockets.sync.client import connect
 
 # What viser's page sends first: its camera. viser counts a client as connected from that message on.

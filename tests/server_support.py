@@ -7,7 +7,7 @@ import time
 
 import fsm
 import httpx
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from websockets.sync.client import connect
 
 

@@ -2,7 +2,7 @@
 
 A dashboard's routes, the lease's deadman and the control frames call a machine only through
 ``Controls``: a machine of this process (``handle.MachineHandle``), one another process publishes
-(server/remote_control.py's ``RemoteHandle``, over its websocket or Zenoh), and whatever kind comes
+(fsmscope/server/remote_control.py's ``RemoteHandle``, over its websocket or Zenoh), and whatever kind comes
 next implements the same calls. Each control returns the seq of the ``control`` event it caused
 in the machine's stream, or raises ``Refused`` with the HTTP status a server answers it with and
 the message the operator reads; a server maps ``Refused`` to HTTP in one place.

@@ -1,6 +1,6 @@
 """The deadman a machine's own process applies when its link to the dashboard whose operator holds
 the machine's lease is lost for longer than the lease's ``after``: the websocket publisher's
-connection (server/publisher.py), or a dashboard's liveliness on Zenoh (fleet/control.py).
+connection (fsmscope/server/publisher.py), or a dashboard's liveliness on Zenoh (fsmscope/fleet/control.py).
 
 The dashboard says each lease (``lease`` frames, ``frames.lease_of``); ``lost()`` arms a timer per
 machine leased, ``back()`` disarms them all. A timer armed for an outage that has ended does

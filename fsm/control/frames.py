@@ -1,8 +1,8 @@
-"""The publishing process's side of remote control (server/remote_control.py is the server's): a
+"""The publishing process's side of remote control (fsmscope/server/remote_control.py is the server's): a
 control frame applied to a machine of this process through the same ``Controls`` (its
 ``MachineHandle``) a local machine's requests go through, and the deadman a publisher applies itself
 when its connection to the dashboard is gone while an operator holds the machine's lease. The
-websocket publisher (server/publisher.py) and the Zenoh robot (fleet/robot.py) both apply frames here.
+websocket publisher (fsmscope/server/publisher.py) and the Zenoh robot (fsmscope/fleet/robot.py) both apply frames here.
 """
 
 from __future__ import annotations

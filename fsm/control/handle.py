@@ -73,7 +73,7 @@ class MachineHandle:
 
     def lease_changed(self, held: bool, after: float, action: str) -> None:
         """Nothing to tell: the server applies the deadman itself to a machine of its own process
-        (a remote machine's handle tells its publisher, server/remote_control.py)."""
+        (a remote machine's handle tells its publisher, fsmscope/server/remote_control.py)."""
 
     # The debugger (attached on the first of these calls: a machine nobody debugs never pays for one).
     @property

@@ -10,7 +10,7 @@
   snapshot (found through the ``.idx`` sidecar), or by scanning when the index is missing
   or stale.
 * ``complete_lines(handle, offset)`` yields the lines from a byte offset on, with their offsets,
-  for readers that index a log themselves (server/history.py); a last line still being written
+  for readers that index a log themselves (fsmscope/server/history.py); a last line still being written
   is left for later.
 """
 

@@ -11,7 +11,7 @@ holds more than one machine, the path is prefixed with the machine's name (``foo
 
 SMACH had no operator controls or debugger: a ``control`` event (preempt, initial-state, start,
 publish from the dashboard) and a ``debug`` event (pause, hold, step, forced outcome, breakpoints)
-read word for word as the browser's transcript (static/transcript.js) writes them.
+read word for word as the browser's transcript (fsmscope/static/transcript.js) writes them.
 """
 
 from __future__ import annotations
@@ -112,7 +112,7 @@ class Transcript:
 
 
 def control_message(event: dict) -> tuple[str, str]:
-    """(level, text) of a control event, as static/transcript.js words it: the operator's action
+    """(level, text) of a control event, as fsmscope/static/transcript.js words it: the operator's action
     reads the same in a headless replay as in the dashboard."""
     accepted = event.get("result") == "accepted"
     params = " " + value_text(event["params"], CONTROL_PARAMS_LIMIT) if event.get("params") else ""
@@ -123,7 +123,7 @@ def control_message(event: dict) -> tuple[str, str]:
 
 
 def debug_message(event: dict) -> tuple[str, str]:
-    """(level, text) of a debug event, as static/transcript.js words it."""
+    """(level, text) of a debug event, as fsmscope/static/transcript.js words it."""
     action, state = event["action"], event.get("state")
     by = " by %s" % event["by"] if event.get("by") else ""
     if action == "mode":
@@ -146,7 +146,7 @@ MODE_WORDS = {"run": "running", "pause": "pausing at the next transition", "step
 
 
 def breakpoint_text(bp: dict) -> str:
-    """``before /SM_ROOT/PICK/CLOSE when attempts > 2``, as static/transcript.js writes it."""
+    """``before /SM_ROOT/PICK/CLOSE when attempts > 2``, as fsmscope/static/transcript.js writes it."""
     text = "%s %s" % (bp.get("at"), bp.get("state"))
     if bp.get("outcome") is not None:
         text += " with outcome '%s'" % bp["outcome"]
@@ -161,7 +161,7 @@ def _coalesce(value: Any, default: Any) -> Any:
 
 
 def value_text(value: Any, limit: int = 200) -> str:
-    """static/transcript.js's valueText: an encoded value (docs/events.md) on one line, cut after
+    """fsmscope/static/transcript.js's valueText: an encoded value (docs/events.md) on one line, cut after
     ``limit`` characters as JavaScript counts them."""
     if isinstance(value, dict) and isinstance(value.get("$repr"), str):
         text = value["$repr"]

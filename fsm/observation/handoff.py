@@ -1,4 +1,4 @@
-"""Events handed from a machine's thread to a sender's (server/publisher.py): the
+"""Events handed from a machine's thread to a sender's (fsmscope/server/publisher.py): the
 observer appends to a bounded queue and never waits (when it is full the oldest event is dropped,
 and counted); the sender is woken, takes the events, and says while it is busy with them."""
 

@@ -10,7 +10,7 @@ and fragment, and Zenoh's too), without control characters, and without a space 
 ``valid`` makes a name that keeps the rule out of any text (a script's file name, an introspection
 server's ROS name); ``unique`` makes it differ from the names already taken, the one way every
 namer does it: ``name``, ``name-2``, ``name-3``... The event schema's ``machine`` field and the
-fleet's key chunks check this rule, and ``static/schema.js`` carries it to the page
+fleet's key chunks check this rule, and ``fsmscope/static/schema.js`` carries it to the page
 (``python -m server.schema_export``).
 
 Standard library only, like the rest of ``fsm``.

@@ -1,8 +1,8 @@
 """Text from outside (a log, a bag, a machine's paths and messages) as fsmscope shows it: each
 control character as a sign, seen and never obeyed. A terminal obeys ESC (colours, the window's
 title, clearing the screen), CSI (U+009B, in some terminals), BEL, BS and CR (writing over what a
-line said); XML cannot hold them. The graph's labels (server/graph.py) and every line the command
-line prints from a log or a bag (server/cli/) use this one rule: C0 characters and DEL as their
+line said); XML cannot hold them. The graph's labels (fsmscope/server/graph.py) and every line the command
+line prints from a log or a bag (fsmscope/server/cli/) use this one rule: C0 characters and DEL as their
 Unicode control pictures (U+2400 + code, U+2421: ESC is ␛), the C1 characters and the
 non-characters U+FFFE, U+FFFF as U+FFFD."""
 

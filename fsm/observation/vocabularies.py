@@ -1,6 +1,6 @@
 """The words the server and the page share beyond the events' fields, defined once: a machine's run
 state (what the dashboard's pill and picker and the fleet's tiles say) and the kinds of the
-timeline's ticks. ``static/schema.js`` carries them to the page (``python -m server.schema_export``,
+timeline's ticks. ``fsmscope/static/schema.js`` carries them to the page (``python -m server.schema_export``,
 with ``runState``, the page's mirror of ``run_state``: tests/unit/test_vocabularies.py runs both).
 
 Standard library only, like the rest of ``fsm``.
@@ -25,7 +25,7 @@ def run_state(running: bool, outcome: str | None, error: object, connected: bool
     return GONE if connected is False else IDLE
 
 
-# The timeline's ticks (server/timeline.py): an event of one of these kinds, or a run's start.
+# The timeline's ticks (fsmscope/server/timeline.py): an event of one of these kinds, or a run's start.
 EVENT_TICK_KINDS = ("error", "preempt", "control", "debug")
 RUN_TICK = "run"
 TICK_KINDS = EVENT_TICK_KINDS + (RUN_TICK,)

@@ -6,8 +6,8 @@ from bag_support import GRASP, PLACE, ROOT, write_bag
 from recording_support import replay_served
 
 from fsm.observation.schema import container_id, state_id
-from server.testing.browser import open_page
-from server.testing.polling import wait_for
+from fsmscope.server.testing.browser import open_page
+from fsmscope.server.testing.polling import wait_for
 
 
 def test_a_ros1_bag_replayed_shows_its_run_in_the_dashboard(browser, tmp_path):

@@ -1,4 +1,4 @@
-"""The labels the graph marks (static/graph_marks.js draws a mark as a copy over the drawing) are seen
+"""The labels the graph marks (fsmscope/static/graph_marks.js draws a mark as a copy over the drawing) are seen
 once at 1440x900 (issue 31, item 8): an active or failed container's name, and the label of the edge
 last taken, were drawn again in bold over the drawing's own, wider, so both showed, ~9 px apart."""
 
@@ -9,7 +9,7 @@ import threading
 import fsm
 import pytest
 from browser_support import page_at
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 from smach_support import failing_machine, run_to_failure
 
 # The boxes of every text of the graph (the drawing's and the marks' copies) that reads `label`.

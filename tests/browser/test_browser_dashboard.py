@@ -17,9 +17,9 @@ from pathlib import Path
 
 import pytest
 from browser_support import ACTIVE_LEAF, filter_log
-from server.testing.browser import PAGE_WAIT_MS
-from server.testing.demo_process import free_port
-from server.testing.polling import wait_for
+from fsmscope.server.testing.browser import PAGE_WAIT_MS
+from fsmscope.server.testing.demo_process import free_port
+from fsmscope.server.testing.polling import wait_for
 
 XSS = "<img src=x onerror=alert(1)>"
 ROOT = Path(__file__).resolve().parents[2]
@@ -73,7 +73,7 @@ def serve(port: int, token: str) -> None:
     import threading
 
     import fsm
-    from server.introspection_server import IntrospectionServer
+    from fsmscope.server.introspection_server import IntrospectionServer
 
     quiet = lambda msg: None  # noqa: E731
     fsm.set_loggers(quiet, quiet, quiet, quiet)
@@ -131,7 +131,7 @@ class ServerProcess:
 
 @pytest.fixture(scope="module")
 def server(tmp_path_factory):
-    pytest.importorskip("server.introspection_server", reason="the backend (server/) is not there yet")
+    pytest.importorskip("fsmscope.server.introspection_server", reason="the backend (server/) is not there yet")
     proc = ServerProcess(tmp_path_factory.mktemp("server"))
     proc.start()
     yield proc
@@ -320,7 +320,7 @@ def test_page_recovers_when_the_server_restarts(page, server):
 
 
 def test_js_reducer_matches_python(page):
-    """fsm.observation.status.Status and static/status.js rebuild the same state from the same events, over two runs."""
+    """fsm.observation.status.Status and fsmscope/static/status.js rebuild the same state from the same events, over two runs."""
     import fsm
     from fsm.observation.status import rebuild
 

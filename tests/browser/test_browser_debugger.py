@@ -14,8 +14,8 @@ import time
 import fsm
 import pytest
 from browser_support import as_page, banner_saying, served_page
-from server.testing.browser import open_page
-from server.testing.polling import wait_for
+from fsmscope.server.testing.browser import open_page
+from fsmscope.server.testing.polling import wait_for
 from server_support import client
 
 BREAKPOINTS = "/api/machines/rounds/breakpoints"

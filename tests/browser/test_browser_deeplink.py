@@ -7,9 +7,9 @@ from __future__ import annotations
 import time
 
 import pytest
-from server.http_server import ServerThread
-from server.testing.browser import PAGE_WAIT_MS
-from server.testing.polling import wait_for
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.browser import PAGE_WAIT_MS
+from fsmscope.server.testing.polling import wait_for
 from server_support import client, two_state_machine
 
 NAMES = ("m0", "m1")

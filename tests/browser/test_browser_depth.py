@@ -1,4 +1,4 @@
-"""Which containers the graph draws open (static/depth.js): the depth selector and a double-click on
+"""Which containers the graph draws open (fsmscope/static/depth.js): the depth selector and a double-click on
 one container. A closed container is drawn as one node (s:PATH), an open one as a cluster (c:PATH)."""
 
 from __future__ import annotations
@@ -6,7 +6,7 @@ from __future__ import annotations
 import pytest
 from browser_support import watching
 from fsm.observation.schema import container_id, state_id
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 from server_support import nested_machine
 
 SUB = "/SM_ROOT/SUB"

@@ -1,4 +1,4 @@
-"""The details of the selected state (static/details.js) at 1440x900 (issue 31, item 10): a state whose
+"""The details of the selected state (fsmscope/static/details.js) at 1440x900 (issue 31, item 10): a state whose
 class has no docstring (fsm's own CBState) says so, where a literal `null` was shown."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import threading
 import fsm
 import pytest
 from browser_support import page_at
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 
 
 class Documented(fsm.State):

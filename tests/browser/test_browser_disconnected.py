@@ -8,8 +8,8 @@ import signal
 import fsm
 import pytest
 from browser_support import watch
-from server.http_server import ServerThread
-from server.testing.polling import wait_for
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.polling import wait_for
 from publishing_support import publish, remote
 
 

@@ -7,7 +7,7 @@ import threading
 import fsm
 import pytest
 from browser_support import filter_log, served_page, watch
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 from smach_support import WaitForPreempt, concurrence, machine
 
 

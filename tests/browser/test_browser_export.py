@@ -14,10 +14,10 @@ from export_support import LOOPS, MARKUP, NAME, exported_run, seq_of
 from recording_support import record, replay_served
 from fsm.logfiles.log_reader import seek
 from fsm.observation.schema import state_id
-from server import export_html
-from server.testing.big_machine import big_machine
-from server.testing.browser import PAGE_WAIT_MS, open_page
-from server.testing.polling import wait_for
+from fsmscope.server import export_html
+from fsmscope.server.testing.big_machine import big_machine
+from fsmscope.server.testing.browser import PAGE_WAIT_MS, open_page
+from fsmscope.server.testing.polling import wait_for
 
 
 @pytest.fixture(scope="module")

@@ -8,10 +8,10 @@ import threading
 import fsm
 import pytest
 from browser_support import mark_style, watch
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 from smach_support import failing_machine, run_to_failure
 
-ERROR_RED = "rgb(198, 40, 40)"  # --err of static/style.css
+ERROR_RED = "rgb(198, 40, 40)"  # --err of fsmscope/static/style.css
 
 
 def calm_machine():

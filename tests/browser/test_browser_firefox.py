@@ -31,7 +31,7 @@ def looping_machine() -> fsm.StateMachine:
 def served():
     if not os.path.exists(FIREFOX):
         pytest.skip("Debian's firefox-esr is not installed (make apt)")
-    from server.introspection_server import IntrospectionServer
+    from fsmscope.server.introspection_server import IntrospectionServer
 
     sm = looping_machine()
     stop = threading.Event()

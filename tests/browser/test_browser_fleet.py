@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 from fleet_support import Dashboard, Robot
-from server.testing.browser import PAGE_WAIT_MS
+from fsmscope.server.testing.browser import PAGE_WAIT_MS
 
 
 TOKEN = "fleet-token"

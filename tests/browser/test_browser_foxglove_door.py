@@ -1,4 +1,4 @@
-"""`--foxglove`'s door (interop/foxglove_door.py) in real Chromium: a page of another site, or a
+"""`--foxglove`'s door (fsmscope/interop/foxglove_door.py) in real Chromium: a page of another site, or a
 local file's page, cannot read a machine's events from the Foxglove server, neither through its
 port nor through the SDK's inner one; a page of Foxglove's web app can, and so can a file's page
 once the user allowed the origin ``null``."""
@@ -10,9 +10,9 @@ import threading
 import fsm
 import pytest
 
-from interop.foxglove_door import Admission
-from interop.foxglove_live import FoxgloveLive
-from server.testing.browser import PAGE_WAIT_MS
+from fsmscope.interop.foxglove_door import Admission
+from fsmscope.interop.foxglove_live import FoxgloveLive
+from fsmscope.server.testing.browser import PAGE_WAIT_MS
 
 # What a page can read: the first event of the machine's events channel, or why it read none.
 READ_AN_EVENT = """([url, topic]) => new Promise(resolve => {

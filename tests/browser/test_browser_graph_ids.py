@@ -1,5 +1,5 @@
 """State names the graph's ids must escape (a control character, a percent sign): the page finds
-their elements through the same id definition as the server (static/schema.js from fsm/observation/schema/)."""
+their elements through the same id definition as the server (fsmscope/static/schema.js from fsm/observation/schema/)."""
 
 from __future__ import annotations
 

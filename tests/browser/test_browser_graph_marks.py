@@ -1,4 +1,4 @@
-"""The graph's marks are drawn by an overlay of copies (static/graph_marks.js): each marked element of the
+"""The graph's marks are drawn by an overlay of copies (fsmscope/static/graph_marks.js): each marked element of the
 drawing has a copy lying exactly over it, styled by the mark, while the drawing itself is never restyled (so
 Chromium never repaints it when the instant changes)."""
 

@@ -9,8 +9,8 @@ import threading
 import fsm
 import pytest
 from browser_support import page_at
-from server.http_server import ServerThread
-from server.testing.polling import wait_for
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.polling import wait_for
 
 from server_support import looping_machine
 

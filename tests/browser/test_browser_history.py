@@ -8,9 +8,9 @@ import threading
 import fsm
 import pytest
 from browser_support import watch
-from server.feed import HISTORY
-from server.http_server import ServerThread
-from server.testing.polling import wait_for
+from fsmscope.server.feed import HISTORY
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.polling import wait_for
 
 
 def gated_machine(gate: threading.Event):

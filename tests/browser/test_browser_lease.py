@@ -9,9 +9,9 @@ import threading
 import httpx
 import pytest
 from browser_support import banner_saying, served_page, watch
-from server.testing.browser import CHROMIUM, open_page
-from server.testing.demo_process import DemoProcess
-from server.testing.polling import wait_for
+from fsmscope.server.testing.browser import CHROMIUM, open_page
+from fsmscope.server.testing.demo_process import DemoProcess
+from fsmscope.server.testing.polling import wait_for
 
 from server_support import looping_machine
 

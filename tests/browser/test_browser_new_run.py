@@ -7,7 +7,7 @@ import threading
 import fsm
 import pytest
 from browser_support import watch
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 from smach_support import two_level_machine
 
 SUB = "/SM_ROOT/SUB"

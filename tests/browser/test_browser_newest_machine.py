@@ -13,8 +13,8 @@ import sys
 import threading
 
 from browser_support import ROOT
-from server.testing.browser import open_page
-from server.testing.polling import wait_for
+from fsmscope.server.testing.browser import open_page
+from fsmscope.server.testing.polling import wait_for
 
 # Machine N waits in WAIT until the file goN exists in the working directory, then ends: a new one is built.
 SCRIPT = """
@@ -42,7 +42,7 @@ def fsmscope_run(tmp_path):
     lets machine N end); stopped at the end, its last machine let go."""
     script = tmp_path / "loop.py"
     script.write_text(SCRIPT)
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "run", "--exit", str(script)], cwd=tmp_path,
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "run", "--exit", str(script)], cwd=tmp_path,
                             env=dict(os.environ, PYTHONPATH=str(ROOT)), stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, text=True)
     lines: queue.Queue = queue.Queue()

@@ -11,9 +11,9 @@ import threading
 import fsm
 import pytest
 from browser_support import page_at, serving_while_running
-from server.http_server import ServerThread
-from server.testing.big_machine import big_machine
-from server.testing.mission import mission_machine
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.big_machine import big_machine
+from fsmscope.server.testing.mission import mission_machine
 
 WIDTH, HEIGHT = 1440, 900
 FLOOR_PX = 9  # a state's label on screen, at least
@@ -42,9 +42,9 @@ LABELS_IN = """(part) => {
 
 
 def demo_machine():
-    """The demo's pick-and-place machine (sim/task.py) on its simulated world, not run."""
-    from sim.task import build_task_machine
-    from sim.world import World
+    """The demo's pick-and-place machine (fsmscope/sim/task.py) on its simulated world, not run."""
+    from fsmscope.sim.task import build_task_machine
+    from fsmscope.sim.world import World
 
     return build_task_machine(World())
 

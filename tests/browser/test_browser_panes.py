@@ -1,13 +1,13 @@
-"""The panes (static/panes.js): splitters resize the grid's tracks by dragging, the sizes survive a reload
+"""The panes (fsmscope/static/panes.js): splitters resize the grid's tracks by dragging, the sizes survive a reload
 (localStorage), the demo's layout (with the 3D view, 1600x900) gives the hierarchy and the userdata more
-than 182 px; and the hierarchy follows the active state (static/tree.js)."""
+than 182 px; and the hierarchy follows the active state (fsmscope/static/tree.js)."""
 
 from __future__ import annotations
 
 import pytest
 from browser_support import serving_while_running, watching
-from server.testing.big_machine import big_machine
-from server.testing.browser import open_page
+from fsmscope.server.testing.big_machine import big_machine
+from fsmscope.server.testing.browser import open_page
 
 
 @pytest.fixture(scope="module")

@@ -54,7 +54,7 @@ def test_the_seconds_since_the_preempt_was_requested_keep_counting(preempted):
 
 
 def test_the_page_and_python_agree_on_which_states_a_preempt_waits_on(preempted):
-    """static/status.js preemptWaitingOn() mirrors fsm/observation/status.py preempt_waiting_on()."""
+    """fsmscope/static/status.js preemptWaitingOn() mirrors fsm/observation/status.py preempt_waiting_on()."""
     import json
 
     from fsm.observation.status import rebuild

@@ -1,5 +1,5 @@
-"""A page whose read is refused for the budget of the server's time (429, server/read_budget.py) waits the
-Retry-After it is told and asks again (static/api.js): the page gets its answer, not an error."""
+"""A page whose read is refused for the budget of the server's time (429, fsmscope/server/read_budget.py) waits the
+Retry-After it is told and asks again (fsmscope/static/api.js): the page gets its answer, not an error."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import secrets
 import httpx
 
 from browser_support import watching
-from server.http_server import ServerThread
-from server.read_budget import ReadBudget
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.read_budget import ReadBudget
 from server_support import two_state_machine
 
 # Once the page is open: an address's clients share 4 x 0.02 s of the server's work at once, refilled at

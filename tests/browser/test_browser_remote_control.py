@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 from browser_support import watch
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 from publishing_support import published  # noqa: F401 (the fixture: a publishing subprocess)
 

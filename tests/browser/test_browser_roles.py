@@ -5,7 +5,7 @@ from __future__ import annotations
 import urllib.parse
 
 from browser_support import served_page
-from server.testing.browser import open_page
+from fsmscope.server.testing.browser import open_page
 from server_support import two_state_machine
 
 CONTROLS = ("#preempt-btn", "#start-btn")

@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 from browser_support import scene_client
 from fsm.logfiles.log_reader import read_events
-from server.cli import replay
-from server.cli.demo import pose_events
-from server.http_server import ServerThread
-from server.hub import Hub
-from server.testing.browser import open_page
-from server.testing.polling import wait_for
+from fsmscope.server.cli import replay
+from fsmscope.server.cli.demo import pose_events
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.hub import Hub
+from fsmscope.server.testing.browser import open_page
+from fsmscope.server.testing.polling import wait_for
 
 MACHINE = "pick_place"
 FLOAT32 = 1e-6  # viser keeps positions as float32
@@ -30,8 +30,8 @@ FLOAT32 = 1e-6  # viser keeps positions as float32
 def live_arm():
     """The demo's arm running its episodes in real time, its machine and pose served with the 3D view
     as `fsmscope demo` serves them: (server, scene, world)."""
-    from sim.demo import SimDemo
-    from sim.pose import PoseTap
+    from fsmscope.sim.demo import SimDemo
+    from fsmscope.sim.pose import PoseTap
 
     fsm.set_loggers(*(lambda msg: None,) * 4)
     demo = SimDemo(seed=0, scene=True)

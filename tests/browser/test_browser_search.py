@@ -1,5 +1,5 @@
-"""The search palette (static/search.js, search_index.js) and the details of the selected state
-(static/details.js) on a generated machine of several hundred states (server/testing/big_machine.py)
+"""The search palette (fsmscope/static/search.js, search_index.js) and the details of the selected state
+(fsmscope/static/details.js) on a generated machine of several hundred states (fsmscope/server/testing/big_machine.py)
 whose container names carry markup, in Chromium."""
 
 from __future__ import annotations
@@ -8,8 +8,8 @@ from __future__ import annotations
 import pytest
 from browser_support import serving_while_running, watching
 from fsm.observation.schema import container_id, state_id
-from server.testing.big_machine import big_machine, count_states
-from server.testing.polling import wait_for
+from fsmscope.server.testing.big_machine import big_machine, count_states
+from fsmscope.server.testing.polling import wait_for
 
 MARKUP = "<img src=x onerror=window.__xss=1>T"  # the prefix of every container's name
 BRANCHING, DEPTH, LEAVES = 3, 4, 8  # 360 states: the server's default draws only the root open

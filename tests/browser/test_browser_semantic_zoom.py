@@ -1,5 +1,5 @@
 """A machine of several hundred states in the graph pane (issue 11): semantic zoom ("auto" opens the
-active path and closes idle branches, static/semantic_zoom.js), the view kept in place across its
+active path and closes idle branches, fsmscope/static/semantic_zoom.js), the view kept in place across its
 re-layouts (graph_fit.js), the breadcrumb of the container in view (breadcrumb.js), a fit that keeps
 labels readable, the minimap (minimap.js)."""
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 from browser_support import serving_while_running, watching
 from fsm.observation.schema import container_id
-from server.testing.big_machine import big_machine, count_states
+from fsmscope.server.testing.big_machine import big_machine, count_states
 
 SHAPE = (3, 4, 6)  # branching, depth, leaves: 40 containers, 280 states
 TICK = 0.1  # seconds a leaf runs: a container is active about 0.6 s, longer than semantic zoom takes to open it (<= 400 ms apart)

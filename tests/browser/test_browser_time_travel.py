@@ -13,11 +13,11 @@ import fsm
 import pytest
 from browser_support import scene_client, served_page
 from fsm.logfiles.log_reader import read_events, seek
-from server.cli import replay
-from server.http_server import ServerThread
-from server.hub import Hub
-from server.testing.browser import open_page
-from server.testing.polling import wait_for
+from fsmscope.server.cli import replay
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.hub import Hub
+from fsmscope.server.testing.browser import open_page
+from fsmscope.server.testing.polling import wait_for
 
 MACHINE = "pick_place"
 STEPPED = ("start", "transition", "terminate")

@@ -1,4 +1,4 @@
-"""The timeline component (static/timeline.js) in the served dashboard page, on a host element of its
+"""The timeline component (fsmscope/static/timeline.js) in the served dashboard page, on a host element of its
 own with synthetic /timeline data: what the user's drags, clicks, wheel and keys ask of the page, the
 "back to live" control, and names drawn as text."""
 

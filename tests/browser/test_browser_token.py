@@ -9,8 +9,8 @@ import threading
 
 import pytest
 
-from server.http_server import ServerThread
-from server.testing.browser import PAGE_WAIT_MS
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.browser import PAGE_WAIT_MS
 from server_support import two_state_machine
 
 

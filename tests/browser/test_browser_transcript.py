@@ -1,4 +1,4 @@
-"""The browser's transcript (static/transcript.js) is the terminal's (fsm.logfiles.transcript), line for line.
+"""The browser's transcript (fsmscope/static/transcript.js) is the terminal's (fsm.logfiles.transcript), line for line.
 
 Both rebuild SMACH's log lines from the same events; the Python side is checked against the
 runtime's own printed lines (tests/unit/test_transcript.py). Here each example is recorded as
@@ -25,7 +25,7 @@ from fsm.logfiles.transcript import Transcript
 from recording_support import EXAMPLES, FAST, cli, record
 from smach_support import Out, WaitForPreempt, concurrence, machine
 
-STATIC = Path(__file__).resolve().parents[2] / "static"
+STATIC = Path(__file__).resolve().parents[2] / "fsmscope" / "static"
 ORIGIN = "http://transcript.test"
 
 

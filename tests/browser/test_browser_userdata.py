@@ -9,7 +9,7 @@ import threading
 import fsm
 import pytest
 from browser_support import page_at
-from server.http_server import ServerThread
+from fsmscope.server.http_server import ServerThread
 
 ROOT = "/SM_ROOT"
 # Nine keys: WRITE counts `attempts` (0 -> 1), writes `target` again with the value it had, and

@@ -1,4 +1,4 @@
-"""static/shown.js's view(): what the graph shows (active states, running containers, outcomes
+"""fsmscope/static/shown.js's view(): what the graph shows (active states, running containers, outcomes
 reached, last edges, failed paths) from the events of a real run, called in the page as a pure
 function."""
 

@@ -57,7 +57,7 @@ def held(page):
 
 
 def joints(page) -> dict[str, float]:
-    """The arm's joints in the last pose the demo recorded (sim/pose.py: sampled at 30 Hz, sent when changed)."""
+    """The arm's joints in the last pose the demo recorded (fsmscope/sim/pose.py: sampled at 30 Hz, sent when changed)."""
     return page.evaluate("window.fsmscope.liveStatus.pose.joints")
 
 

@@ -8,9 +8,9 @@ import io
 import pytest
 from browser_support import ACTIVE_LEAF
 from demo_support import watching_demo
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
-# The arm's links are orange in sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
+# The arm's links are orange in fsmscope/sim/arm.xml (rgba 0.85 0.55 0.20); lit and shaded they stay
 # clearly red > green > blue.
 def is_arm_orange(r: int, g: int, b: int) -> bool:
     return r > 120 and r - b > 90 and r > g > b and g - b > 25

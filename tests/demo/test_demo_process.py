@@ -14,9 +14,9 @@ import time
 import pytest
 from browser_support import ROOT
 from demo_support import wait_for_a_fresh_episode
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
-FSMSCOPE = [sys.executable, "-m", "server.cli"]
+FSMSCOPE = [sys.executable, "-m", "fsmscope"]
 
 
 def start_headless_demo(record) -> subprocess.Popen:

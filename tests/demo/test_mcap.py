@@ -12,7 +12,7 @@ from recording_support import cli, record, two_state_loop
 
 from fsm.logfiles.log_reader import read_events
 from fsm.observation import schema
-from interop.mcap_log import McapLogError, read_mcap, write_mcap
+from fsmscope.interop.mcap_log import McapLogError, read_mcap, write_mcap
 
 STATE_KINDS = ("structure", "start", "transition", "terminate")
 
@@ -103,7 +103,7 @@ def test_exporting_over_an_existing_file_is_refused(run, tmp_path):
 
 
 def test_the_demo_arm_is_exported_as_a_frame_per_body_at_every_recorded_pose(headless_demo_log, tmp_path):
-    from sim.pose import PoseFrames
+    from fsmscope.sim.pose import PoseFrames
 
     out = tmp_path / "demo.mcap"
     done = cli("export", headless_demo_log, "--mcap", out)

@@ -1,5 +1,5 @@
 """Zenoh's access control on a robot (docs/fleet.md), given as a user gives it: a Zenoh configuration
-file (``--zenoh-config``; here ``config_file=``, the same path through fleet/config.py) with
+file (``--zenoh-config``; here ``config_file=``, the same path through fsmscope/fleet/config.py) with
 user-password authentication (``transport/auth/usrpwd``: the robot checks each session's user and
 password against its dictionary file) and an ``access_control`` block naming what each user may do.
 User "operator" may do everything on the fleet's keys; user "viewer" may watch (subscribe to the
@@ -14,7 +14,7 @@ Real Zenoh sessions on the loopback: the robot listens on an explicit tcp endpoi
 (a FleetWatcher) connects to it with its own user and password; no multicast scouting.
 
 What Zenoh does with a denied query (eclipse-zenoh 1.10): the querier's ``get`` ends at once with
-no reply, neither an error reply nor a time-out, as if no queryable matched. fleet/query.py takes
+no reply, neither an error reply nor a time-out, as if no queryable matched. fsmscope/fleet/query.py takes
 such an ending for "reached nobody yet" and asks again until its time-out, so a viewer's control
 ends as "no answer" (None; the dashboard's 504) after the watcher's QUERY_TIMEOUT.
 """
@@ -29,10 +29,10 @@ import fsm
 import pytest
 from fleet_support import TOKEN, EVERY_MESSAGE, Dashboard, access_configuration, user_configuration, free_endpoint, run_published, slow_loop
 
-from fleet import control, keys
-from fleet.robot import ZenohRobot
-from fleet.watcher import FleetWatcher
-from server.testing.polling import wait_for
+from fsmscope.fleet import control, keys
+from fsmscope.fleet.robot import ZenohRobot
+from fsmscope.fleet.watcher import FleetWatcher
+from fsmscope.server.testing.polling import wait_for
 
 PASSWORDS = {"operator": "operator-secret", "viewer": "viewer-secret"}
 NAME = "r1:loop"
@@ -117,7 +117,7 @@ def test_a_viewers_dashboard_sees_the_robots_machine_and_its_events(fleet):
 
 
 def test_a_viewers_control_is_never_applied_even_with_the_robots_token(fleet, monkeypatch):
-    monkeypatch.setattr("fleet.watcher.QUERY_TIMEOUT", 1.5)  # the dashboard's 5 s, shortened
+    monkeypatch.setattr("fsmscope.fleet.watcher.QUERY_TIMEOUT", 1.5)  # the dashboard's 5 s, shortened
     viewer = fleet.dashboard("viewer", PASSWORDS["viewer"])
     joined(viewer)
     started = time.monotonic()

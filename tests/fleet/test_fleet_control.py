@@ -1,4 +1,4 @@
-"""Controls across the network (fleet/control.py), over real Zenoh sessions on the loopback: the
+"""Controls across the network (fsmscope/fleet/control.py), over real Zenoh sessions on the loopback: the
 robot's process checks the token itself, applies the control, records it in its own stream, and
 answers with the event it caused; nothing without the robot's token controls its machine."""
 
@@ -11,10 +11,10 @@ import pytest
 import zenoh
 from fleet_support import TOKEN, free_endpoint, run_published, slow_loop
 
-from fleet.config import session_config
-from fleet.robot import ZenohRobot
-from fleet.watcher import FleetWatcher
-from server.testing.polling import wait_for
+from fsmscope.fleet.config import session_config
+from fsmscope.fleet.robot import ZenohRobot
+from fsmscope.fleet.watcher import FleetWatcher
+from fsmscope.server.testing.polling import wait_for
 
 
 

@@ -14,10 +14,10 @@ import zenoh
 from fleet_support import (TOKEN, Dashboard, Robot, Router, free_endpoint, preempted_the_dashboard_has_the_robots_log,
                            run_published, slow_loop)
 
-from fleet.config import session_config
-from fleet.robot import ZenohRobot
-from fleet.watcher import FleetWatcher
-from server.testing.polling import wait_for
+from fsmscope.fleet.config import session_config
+from fsmscope.fleet.robot import ZenohRobot
+from fsmscope.fleet.watcher import FleetWatcher
+from fsmscope.server.testing.polling import wait_for
 
 
 

@@ -13,8 +13,8 @@ import pytest
 from fleet_support import (TOKEN, EVERY_MESSAGE, Dashboard, Robot, Router, access_configuration,
                            preempted_the_dashboard_has_the_robots_log, user_configuration)
 
-from fleet.watcher import FleetWatcher
-from server.testing.polling import wait_for
+from fsmscope.fleet.watcher import FleetWatcher
+from fsmscope.server.testing.polling import wait_for
 
 PASSWORDS = {"r1": "r1-secret", "operator": "operator-secret"}
 

@@ -16,13 +16,13 @@ import zenoh
 from fleet_support import (TOKEN, ROOT, Dashboard, Proxy, Robot, free_endpoint, preempted_the_dashboard_has_the_robots_log,
                            run_published, slow_loop, stop)
 
-from fleet import keys
-from fleet.config import session_config
-from fleet.robot import ZenohRobot
-from fleet.watcher import FleetWatcher
+from fsmscope.fleet import keys
+from fsmscope.fleet.config import session_config
+from fsmscope.fleet.robot import ZenohRobot
+from fsmscope.fleet.watcher import FleetWatcher
 from fsm.logfiles.log_reader import read_events
-from server.cli.demo import MACHINE_NAME
-from server.testing.polling import wait_for
+from fsmscope.server.cli.demo import MACHINE_NAME
+from fsmscope.server.testing.polling import wait_for
 
 
 @pytest.fixture
@@ -143,7 +143,7 @@ def watching():
 def published(command: list[str], log, endpoint: str) -> int:
     """Run ``fsmscope COMMAND`` publishing on Zenoh to ``endpoint`` and recording to ``log``; the seq of
     the last event it recorded."""
-    done = subprocess.run([sys.executable, "-m", "server.cli", *command, "--record", str(log), "--zenoh-connect",
+    done = subprocess.run([sys.executable, "-m", "fsmscope", *command, "--record", str(log), "--zenoh-connect",
                            endpoint, "--zenoh-token", TOKEN], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     return max(e["seq"] for e in read_events(str(log)) if e["kind"] != "snapshot")
@@ -186,7 +186,7 @@ def test_a_robot_that_builds_a_machine_per_episode_publishes_every_one_of_them(t
     endpoint, seen = watching
     stderr = tmp_path / "robot.err"
     with open(stderr, "w") as err:
-        robot = subprocess.Popen([sys.executable, "-m", "server.cli", "run", str(EPISODES), "--no-serve", "--record",
+        robot = subprocess.Popen([sys.executable, "-m", "fsmscope", "run", str(EPISODES), "--no-serve", "--record",
                                   str(tmp_path / "r1.jsonl"), "--zenoh", "r1", "--zenoh-connect", endpoint,
                                   "--zenoh-token", TOKEN], cwd=ROOT, stderr=err, start_new_session=True)
     names = ["r1:episodes"] + ["r1:episodes-%d" % i for i in range(2, 11)]
@@ -205,7 +205,7 @@ def test_a_robot_that_builds_a_machine_per_episode_publishes_every_one_of_them(t
 
 def test_a_script_that_never_closes_its_robot_still_exits(tmp_path):
     script = tmp_path / "forgetful.py"
-    script.write_text(SCRIPT.replace("import fsm\n", "import fsm\nfrom fleet.robot import ZenohRobot\n")
+    script.write_text(SCRIPT.replace("import fsm\n", "import fsm\nfrom fsmscope.fleet.robot import ZenohRobot\n")
                       .replace("sm.execute()", "fsm.attach(sm, ZenohRobot('r1'), name='pick')\nsm.execute()"))
     done = subprocess.run([sys.executable, str(script)], cwd=ROOT, capture_output=True, text=True, timeout=30,
                           env={**os.environ, "PYTHONPATH": str(ROOT)})

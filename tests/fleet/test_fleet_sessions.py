@@ -11,7 +11,7 @@ import sys
 import pytest
 from fleet_support import TOKEN, ROOT, free_endpoint, started, stop
 
-from fleet.robot import ZenohRobot
+from fsmscope.fleet.robot import ZenohRobot
 
 
 def listening_ports() -> set[int]:
@@ -53,7 +53,7 @@ def test_a_robot_told_to_listen_listens_there_only():
     ["router", "--listen", "nonsense"],
 ], ids=["serve", "run", "router"])
 def test_an_endpoint_zenoh_cannot_use_ends_the_command_with_why(command):
-    done = subprocess.run([sys.executable, "-m", "server.cli", *command], cwd=ROOT, capture_output=True, text=True,
+    done = subprocess.run([sys.executable, "-m", "fsmscope", *command], cwd=ROOT, capture_output=True, text=True,
                           timeout=60)
     assert done.returncode == 1
     assert done.stderr.strip().splitlines()[-1] == (
@@ -64,7 +64,7 @@ def test_an_endpoint_zenoh_cannot_use_ends_the_command_with_why(command):
 def test_a_router_whose_port_is_taken_says_so():
     endpoint = free_endpoint()
     with ZenohRobot("r1", listen=[endpoint], token=TOKEN):
-        done = subprocess.run([sys.executable, "-m", "server.cli", "router", "--listen", endpoint], cwd=ROOT,
+        done = subprocess.run([sys.executable, "-m", "fsmscope", "router", "--listen", endpoint], cwd=ROOT,
                               capture_output=True, text=True, timeout=60)
     assert done.returncode == 1
     assert "Address already in use" in done.stderr

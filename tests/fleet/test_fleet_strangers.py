@@ -1,7 +1,7 @@
 """A stranger on the fleet's network (a Zenoh session of its own, without the robot's token) can put on
 a robot's keys, answer its queries and receive its dashboards' queries: it can neither pose as the
 robot, nor answer for it, nor take a control's token, nor play a control again, nor hold the
-dashboard's view of the fleet up (fleet/proofs.py)."""
+dashboard's view of the fleet up (fsmscope/fleet/proofs.py)."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import pytest
 import zenoh
 from fleet_support import TOKEN, Delivered, free_endpoint, run_published, slow_loop
 
-from fleet.config import session_config
-from fleet.robot import ZenohRobot, batch_attachment
+from fsmscope.fleet.config import session_config
+from fsmscope.fleet.robot import ZenohRobot, batch_attachment
 from fsm.observation.encoding import dumps
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 @pytest.fixture

@@ -16,9 +16,9 @@ import fsm
 import pytest
 from fleet_support import TOKEN, ROOT, free_endpoint, slow_loop
 
-from fleet.robot import ZenohRobot
-from fleet.watcher import FleetWatcher
-from server.testing.polling import wait_for
+from fsmscope.fleet.robot import ZenohRobot
+from fsmscope.fleet.watcher import FleetWatcher
+from fsmscope.server.testing.polling import wait_for
 
 
 def openssl(*args: str, cwd: Path) -> None:
@@ -151,7 +151,7 @@ def test_with_mutual_tls_a_robot_without_a_certificate_never_reaches_the_dashboa
 def test_a_zenoh_configuration_file_that_cannot_be_read_is_refused_with_why(tmp_path):
     broken = tmp_path / "broken.json5"
     broken.write_text("{ transport: ")
-    done = subprocess.run([sys.executable, "-m", "server.cli", "serve", "--port", "0", "--zenoh",
+    done = subprocess.run([sys.executable, "-m", "fsmscope", "serve", "--port", "0", "--zenoh",
                            "--zenoh-config", str(broken)], cwd=ROOT, capture_output=True, text=True, timeout=60)
     assert done.returncode == 2
     assert "argument --zenoh-config: cannot use %s as a Zenoh configuration" % broken in done.stderr

@@ -14,12 +14,12 @@ import fsm
 import pytest
 from fleet_support import TOKEN, Delivered, Proxy, free_endpoint, run_published, slow_loop
 
-import fleet.robot
-from fleet.robot import ZenohRobot
+import fsmscope.fleet.robot
+from fsmscope.fleet.robot import ZenohRobot
 from fsm.control.handle import MachineHandle
 from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 @pytest.fixture

@@ -16,7 +16,7 @@ import pytest
 from fsm.observation.encoding import dumps
 
 from recording_support import EXAMPLES, ROOT, cli, replay_served
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 @pytest.fixture(scope="module")
@@ -133,7 +133,7 @@ def test_run_with_log_level_warn_prints_no_info_line(tmp_path):
 def test_run_says_the_dashboards_address_before_the_script_prints_anything(tmp_path):
     script = tmp_path / "chatty.py"
     script.write_text("print('the script speaks')\n")
-    out = subprocess.run([sys.executable, "-m", "server.cli", "run", "--exit", str(script), "--record",
+    out = subprocess.run([sys.executable, "-m", "fsmscope", "run", "--exit", str(script), "--record",
                           str(tmp_path / "r.jsonl")], cwd=ROOT, capture_output=False, stdout=subprocess.PIPE,
                          stderr=subprocess.STDOUT, text=True, timeout=60,
                          env=dict(os.environ, PYTHONPATH=ROOT, PYTHONUNBUFFERED="1"))
@@ -355,7 +355,7 @@ def test_replay_reports_a_truncated_last_line_and_replays_the_rest(foo_bar_log, 
 def test_replay_follow_tails_a_log_until_its_writer_closes_it(tmp_path):
     log = tmp_path / "live.jsonl"
     env = dict(os.environ, FSMSCOPE_TIME_SCALE="0.05", PYTHONPATH=ROOT)
-    writer = subprocess.Popen([sys.executable, "-m", "server.cli", "run", "--exit", os.path.join(EXAMPLES, "nested_monitor.py"),
+    writer = subprocess.Popen([sys.executable, "-m", "fsmscope", "run", "--exit", os.path.join(EXAMPLES, "nested_monitor.py"),
                                "--record", str(log)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
         done = cli("replay", "--follow", log, timeout=30)
@@ -368,7 +368,7 @@ def test_replay_follow_tails_a_log_until_its_writer_closes_it(tmp_path):
 def test_run_records_the_runs_started_from_the_dashboard_after_the_script_ended(tmp_path):
     log = tmp_path / "rerun.jsonl"
     env = dict(os.environ, PYTHONPATH=ROOT)
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "run", os.path.join(EXAMPLES, "foo_bar.py"),
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "run", os.path.join(EXAMPLES, "foo_bar.py"),
                              "--record", str(log)], env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                             text=True)
     lines = queue.Queue()
@@ -426,7 +426,7 @@ def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, si
     script = tmp_path / "sleepy.py"
     script.write_text(SLEEPING_SCRIPT)
     log = tmp_path / "sleepy.jsonl"
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "run", str(script), "--record", str(log)],
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "run", str(script), "--record", str(log)],
                             cwd=ROOT, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True)
     with killed_if_left(proc):
         assert "sleeping\n" in proc.stdout  # reads the script's output up to the line (the machine is in SLEEP)
@@ -439,7 +439,7 @@ def test_one_signal_stops_run_and_its_dashboard_with_the_log_closed(tmp_path, si
 
 def test_ctrl_c_stops_a_command_started_with_sigint_ignored(foo_bar_log):
     # A non-interactive shell starts a command it puts in the background with SIGINT ignored.
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "replay", str(foo_bar_log), "--serve"], cwd=ROOT,
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "replay", str(foo_bar_log), "--serve"], cwd=ROOT,
                             stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN))
     with killed_if_left(proc):
@@ -479,6 +479,6 @@ def test_replay_serve_shows_a_recording_in_the_dashboard_as_view_only(foo_bar_lo
 def test_options_that_mean_nothing_together_are_refused_with_why(command, refused, foo_bar_log, tmp_path):
     args = [{"SCRIPT": os.path.join(EXAMPLES, "foo_bar.py"), "LOG": str(foo_bar_log), "OUT": str(tmp_path / "o.mcap")
              }.get(a, a) for a in command]
-    done = subprocess.run([sys.executable, "-m", "server.cli", *args], cwd=ROOT, capture_output=True, text=True,
+    done = subprocess.run([sys.executable, "-m", "fsmscope", *args], cwd=ROOT, capture_output=True, text=True,
                           timeout=30, env=dict(os.environ, PYTHONPATH=ROOT))
     assert done.returncode == 2 and refused in done.stderr, done.stderr

@@ -24,8 +24,8 @@ import websockets
 from recording_support import two_state_loop
 
 from recording_support import ROOT
-from server.cli.foxglove_bridge import start_foxglove
-from server.http_server import ServerThread
+from fsmscope.server.cli.foxglove_bridge import start_foxglove
+from fsmscope.server.http_server import ServerThread
 
 SUBPROTOCOL = "foxglove.sdk.v1"
 
@@ -128,7 +128,7 @@ def foxglove_port_of(command: list[str], timeout: float = 30.0) -> tuple[subproc
     """``fsmscope COMMAND`` in a real process, and the port of the Foxglove server it says it serves
     (AssertionError with what it said when it says none within ``timeout`` seconds). The process's
     ``said``: the lines of its stderr up to that one; ``more``: a queue of the next ones."""
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", *command], cwd=ROOT, stdout=subprocess.DEVNULL,
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", *command], cwd=ROOT, stdout=subprocess.DEVNULL,
                             stderr=subprocess.PIPE, text=True, start_new_session=True,
                             env=dict(os.environ, PYTHONPATH=ROOT))
     lines: queue.Queue = queue.Queue()
@@ -191,7 +191,7 @@ def test_the_headless_demo_serves_foxglove_its_active_states(tmp_path):
 
 def test_a_client_offering_only_the_older_foxglove_websocket_v1_is_refused():
     """docs/interop.md: foxglove-sdk speaks foxglove.sdk.v1 only (what @foxglove/ws-protocol 0.8.0 offers is refused)."""
-    from interop.foxglove_live import FoxgloveLive
+    from fsmscope.interop.foxglove_live import FoxgloveLive
 
     live = FoxgloveLive(port=0)
 
@@ -221,7 +221,7 @@ def handshake(port: int, host: str, origin: str | None = None) -> str:
 
 
 def test_a_handshake_naming_another_host_is_refused_and_the_loopback_s_names_are_answered():
-    from interop.foxglove_live import FoxgloveLive
+    from fsmscope.interop.foxglove_live import FoxgloveLive
 
     live = FoxgloveLive(port=0)
     try:

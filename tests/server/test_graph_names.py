@@ -31,7 +31,7 @@ def test_states_with_control_characters_in_their_names_draw(live_server):
 
 
 def test_a_control_character_is_shown_as_its_control_picture():
-    from server import graph
+    from fsmscope.server import graph
 
     root = machine_named("VT\x0bBAD")
     rep = fsm.attach(root, name="pictures")

@@ -6,9 +6,9 @@ import pytest
 from fsm.logfiles.log_reader import read_events, seek
 from fsm.logfiles.recorder import Recorder
 
-from server import feed, history
-from server.history import LogHistory
-from server.testing.polling import wait_for
+from fsmscope.server import feed, history
+from fsmscope.server.history import LogHistory
+from fsmscope.server.testing.polling import wait_for
 from server_support import client
 from smach_support import counting_machine
 

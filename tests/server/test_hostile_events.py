@@ -13,7 +13,7 @@ from websockets.sync.client import connect
 
 from event_support import ev, flat_root, run_of
 from recording_support import replay_served
-from server import cli
+from fsmscope.server import cli
 from server_support import client, frames, stream
 
 # Values an attacker or a broken publisher might put anywhere.
@@ -90,7 +90,7 @@ def endpoints_answer(base_url: str, token: str) -> None:
 
 @pytest.fixture(scope="module")
 def server():
-    from server.http_server import ServerThread
+    from fsmscope.server.http_server import ServerThread
 
     srv = ServerThread().start()
     yield srv

@@ -10,7 +10,7 @@ import pytest
 from websockets.sync.client import connect
 
 from event_support import deep_root, ev, flat_root, run_of
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from server_support import client, frames, stream
 
 

@@ -8,7 +8,7 @@ import time
 
 import fsm
 
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from server_support import Stubborn, client, frames, stream, waiting_machine
 
 

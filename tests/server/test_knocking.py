@@ -1,5 +1,5 @@
 """Knocking at a real `fsmscope serve`: refused websocket handshakes (a wrong token, a foreign Origin,
-a foreign Host) and malformed requests do not fill its terminal (server/middleware.py): a refused
+a foreign Host) and malformed requests do not fill its terminal (fsmscope/server/middleware.py): a refused
 handshake is said by no line, a malformed request by at most one a minute."""
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ def sent(port: int, data: bytes) -> str:
 
 def serving() -> tuple[subprocess.Popen, int, queue.Queue]:
     """`fsmscope serve` in a real process, its port, and the lines of its stderr after its address."""
-    proc = subprocess.Popen([sys.executable, "-m", "server.cli", "serve", "--port", "0"], cwd=ROOT, text=True,
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "serve", "--port", "0"], cwd=ROOT, text=True,
                             stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True,
                             env=dict(os.environ, PYTHONPATH=ROOT))
     for line in proc.stderr:

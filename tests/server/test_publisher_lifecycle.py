@@ -7,7 +7,7 @@ from __future__ import annotations
 import signal
 
 from publishing_support import publish, remote
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 def test_a_script_that_exits_right_after_its_run_delivers_the_last_events(live_server, tmp_path):

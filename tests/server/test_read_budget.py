@@ -1,4 +1,4 @@
-"""What reads may cost the server (server/read_budget.py, server/read_cache.py; docs/api.md "Read budget"):
+"""What reads may cost the server (fsmscope/server/read_budget.py, fsmscope/server/read_cache.py; docs/api.md "Read budget"):
 a summary or a timeline asked again with nothing new is the same answer, not worked out again; a client
 that reads past its budget of the server's time is answered 429 with Retry-After, on every read route,
 while another client is still served (a real uvicorn, real HTTP)."""
@@ -11,8 +11,8 @@ import httpx
 import pytest
 from fsm.logfiles.recorder import Recorder
 
-from server.http_server import ServerThread
-from server.read_budget import ReadBudget
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.read_budget import ReadBudget
 from server_support import client
 from smach_support import counting_machine
 

@@ -18,8 +18,8 @@ from websockets.sync.client import connect
 
 from browser_support import ROOT
 from event_support import flat_root, run_of
-from server import remote_control
-from server.testing.polling import wait_for
+from fsmscope.server import remote_control
+from fsmscope.server.testing.polling import wait_for
 from publishing_support import Published, published  # noqa: F401 (the fixture: a publishing subprocess)
 from server_support import client, sleeper
 
@@ -95,7 +95,7 @@ def test_a_control_while_the_publisher_is_disconnected_is_409_saying_so(publishe
 
 
 def held_lease(pub: Published, after: float) -> None:
-    """The operator's lease of the machine is held (as server/lease.py says it), and the publisher
+    """The operator's lease of the machine is held (as fsmscope/server/lease.py says it), and the publisher
     has it: a control sent after the lease frame is answered after the publisher read it."""
     pub.srv.hub.get("remote").controls.lease_changed(True, after, "pause")
     assert pub.http.get("/api/machines/remote/breakpoints").status_code == 200
@@ -118,7 +118,7 @@ def test_a_publisher_cut_off_while_a_lease_is_held_pauses_its_machine_itself(pub
 
 
 def test_a_publisher_back_before_the_deadman_delay_does_not_apply_it(published):
-    from server.http_server import ServerThread
+    from fsmscope.server.http_server import ServerThread
 
     held_lease(published, 1.5)
     published.srv.stop()
@@ -180,7 +180,7 @@ def test_a_control_frame_with_params_of_the_wrong_type_is_answered_422_and_one_w
 
 
 def test_a_publishing_script_needs_no_web_framework():
-    loaded = subprocess.run([sys.executable, "-c", "import sys, server.publisher; print(' '.join(sys.modules))"],
+    loaded = subprocess.run([sys.executable, "-c", "import sys, fsmscope.server.publisher; print(' '.join(sys.modules))"],
                             cwd=ROOT, capture_output=True, text=True, check=True).stdout.split()
     assert [m for m in loaded if m.split(".")[0] in ("fastapi", "starlette", "pydantic", "uvicorn")] == []
 

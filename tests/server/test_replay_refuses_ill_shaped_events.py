@@ -22,7 +22,7 @@ ILL_SHAPED = {
 
 
 def replay(path, *args) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "server.cli", "replay", str(path), *args], cwd=ROOT,
+    return subprocess.run([sys.executable, "-m", "fsmscope", "replay", str(path), *args], cwd=ROOT,
                           capture_output=True, text=True, timeout=60)
 
 

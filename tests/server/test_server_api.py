@@ -8,7 +8,7 @@ import fsm
 import httpx
 from fsm.ros.bus import default_bus
 
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from server_support import client, nested_machine, two_state_machine, waiting_machine
 
 

@@ -3,7 +3,7 @@
 import threading
 
 import pytest
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 from server_support import client, looping_machine
 

@@ -5,9 +5,9 @@ import pytest
 import schemathesis
 from hypothesis import HealthCheck, given, settings
 
-from server.app import create_app
-from server.hub import Hub
-from server.http_server import ServerThread
+from fsmscope.server.app import create_app
+from fsmscope.server.hub import Hub
+from fsmscope.server.http_server import ServerThread
 from server_support import nested_machine, two_state_machine
 
 SCHEMA = schemathesis.openapi.from_dict(create_app(Hub(), "t").openapi())

@@ -8,9 +8,9 @@ import fsm
 from fsm.observation.status import Status
 
 from recording_support import two_state_loop
-from server import fanout, feed
-from server.testing.clients import stalled_stream
-from server.testing.polling import wait_for
+from fsmscope.server import fanout, feed
+from fsmscope.server.testing.clients import stalled_stream
+from fsmscope.server.testing.polling import wait_for
 from server_support import blob_loop, events_of, frames, stream, two_state_machine
 
 

@@ -5,9 +5,9 @@ import threading
 
 import httpx
 import pytest
-from server.http_server import ServerThread
-from server.lease import Deadman
-from server.testing.polling import wait_for
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.lease import Deadman
+from fsmscope.server.testing.polling import wait_for
 
 from server_support import client
 from server_support import looping_machine

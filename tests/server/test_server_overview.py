@@ -1,4 +1,4 @@
-"""The fleet overview's tiles (server/overview.py) through a real server: what each says of its
+"""The fleet overview's tiles (fsmscope/server/overview.py) through a real server: what each says of its
 machine, and the stream that sends them, which takes the token as every stream does."""
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 
 from fsm.observation import schema
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 def tiles(srv) -> dict[str, dict]:

@@ -1,10 +1,10 @@
-"""Roles: the operator's token watches and controls, a viewer's token only watches (server/auth.py)."""
+"""Roles: the operator's token watches and controls, a viewer's token only watches (fsmscope/server/auth.py)."""
 
 import time
 
 import httpx
 import pytest
-from server.refusals import EVERY
+from fsmscope.server.refusals import EVERY
 from websockets.exceptions import InvalidStatus
 from websockets.sync.client import connect
 

@@ -10,10 +10,10 @@ from websockets.exceptions import ConnectionClosed, InvalidStatus
 from websockets.sync.client import connect
 
 from fsm.observation import schema
-from server import fanout
-from server.publisher import Publisher
-from server.testing.clients import stalled_stream
-from server.testing.polling import wait_for
+from fsmscope.server import fanout
+from fsmscope.server.publisher import Publisher
+from fsmscope.server.testing.clients import stalled_stream
+from fsmscope.server.testing.polling import wait_for
 from server_support import (blob_loop, client, events_of, frames, nested_machine, stream, two_state_machine,
                             waiting_machine)
 
@@ -173,7 +173,7 @@ def test_ingest_without_token_is_refused_401(live_server):
 
 
 def test_publisher_keeps_the_machine_running_without_a_server_and_reconnects():
-    from server.http_server import ServerThread
+    from fsmscope.server.http_server import ServerThread
 
     srv = ServerThread().start()
     port, token = srv.port, srv.token

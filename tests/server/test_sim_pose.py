@@ -12,13 +12,13 @@ import numpy as np
 import pytest
 
 from fsm.observation.schema import validate
-from server.http_server import ServerThread
-from server.testing.polling import wait_for
+from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.polling import wait_for
 from scene_support import ViewClient
 from server_support import client
-from sim.pose import DEFAULT_RATE, PoseLayout, PoseTap
-from sim.scene import start_pose_scene, start_scene
-from sim.world import ARM_JOINTS, FINGER_JOINTS, HOME_Q, World
+from fsmscope.sim.pose import DEFAULT_RATE, PoseLayout, PoseTap
+from fsmscope.sim.scene import start_pose_scene, start_scene
+from fsmscope.sim.world import ARM_JOINTS, FINGER_JOINTS, HOME_Q, World
 
 FLOAT32 = 1e-6  # viser keeps positions as float32
 # A world's xpos after mj_step is the kinematics of the step's starting qpos: it lags the recorded

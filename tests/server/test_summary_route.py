@@ -7,8 +7,8 @@ from fsm.logfiles.log_reader import read_events
 from fsm.logfiles.recorder import Recorder
 from fsm.logfiles.summary import summarize
 
-from server import state_stats
-from server.read_budget import ReadBudget
+from fsmscope.server import state_stats
+from fsmscope.server.read_budget import ReadBudget
 from server_support import client
 from smach_support import counting_machine
 

@@ -1,4 +1,4 @@
-"""The timeline of a machine (server/timeline.py, GET /api/machines/{name}/timeline): bands per
+"""The timeline of a machine (fsmscope/server/timeline.py, GET /api/machines/{name}/timeline): bands per
 container, ticks, zoom and its bounds, against a real uvicorn and real machines."""
 
 import random
@@ -8,9 +8,9 @@ import fsm
 import pytest
 from fsm.observation.schema import event
 
-import server.timeline
-from server.testing.polling import wait_for
-from server.timeline import MANY, TimelineIndex
+import fsmscope.server.timeline
+from fsmscope.server.testing.polling import wait_for
+from fsmscope.server.timeline import MANY, TimelineIndex
 from server_support import client, sleeper, waiting_machine
 from smach_support import Out, concurrence, failing_machine, machine, run_to_failure
 
@@ -194,8 +194,8 @@ def test_zooming_in_shows_every_state_of_the_range():
 
 
 def test_past_its_cap_the_index_coalesces_its_older_half_and_says_so(monkeypatch):
-    monkeypatch.setattr(server.timeline, "MAX_MARKS", 10_000)
-    monkeypatch.setattr(server.timeline, "COARSE_BUCKETS", 100)
+    monkeypatch.setattr(fsmscope.server.timeline, "MAX_MARKS", 10_000)
+    monkeypatch.setattr(fsmscope.server.timeline, "COARSE_BUCKETS", 100)
     index = long_run(50_000)
     whole = index.answer()
     bands = whole["bands"]["/SM_ROOT/SUB"]

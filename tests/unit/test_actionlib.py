@@ -6,7 +6,7 @@ import pytest
 
 from fsm.ros.actionlib import GoalStatus, SimpleActionClient, SimpleActionServer
 from bus_support import serve, until_preempted
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 def running_goal(bus, servers):

@@ -14,8 +14,8 @@ from recording_support import cli
 
 from fsm.logfiles.log_reader import read_events
 from fsm.observation import schema
-from interop import bag_reader, smach_events
-from interop.testing import container_run, wide_run
+from fsmscope.interop import bag_reader, smach_events
+from fsmscope.interop.testing import container_run, wide_run
 
 LAYOUTS = {"ros1": "run.bag", "ros1-raw": "run.bag", "ros2-sqlite3": "run", "ros2-mcap": "run"}
 
@@ -232,7 +232,7 @@ def test_import_refuses_a_path_longer_than_the_schema_allows_as_replay_does_and_
 
 
 def test_an_event_the_schema_refuses_is_not_written_and_the_rest_are(tmp_path):
-    from interop.to_log import write_log
+    from fsmscope.interop.to_log import write_log
 
     good = schema.build.log(1, 1.0, None, "m", "/ROOT", "info", "kept")
     told = []

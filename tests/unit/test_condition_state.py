@@ -6,7 +6,7 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from fsm.ros.condition_state import ConditionState
 from smach_support import Background, machine
 

@@ -10,7 +10,7 @@ import pytest
 from fsm.control.controls import Controls, NoControls, Refused
 from fsm.control.handle import MachineHandle
 
-from server.remote_control import RemoteHandle
+from fsmscope.server.remote_control import RemoteHandle
 
 def members() -> list[str]:
     return sorted(name for name in vars(Controls) if not name.startswith("_"))

@@ -1,6 +1,6 @@
 """A run given no log records to ``runs/<script>-<time>.jsonl``, opened exclusively: processes started
 in the same second (the one-laptop fleet set-up starts its robots so) each get a file of their own,
-never one file between them (server/runner.py ``open_recorder``)."""
+never one file between them (fsmscope/server/runner.py ``open_recorder``)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import multiprocessing
 import os
 from pathlib import Path
 
-from server.runner import open_recorder
+from fsmscope.server.runner import open_recorder
 
 
 def open_at_once(directory: str, barrier, paths) -> None:

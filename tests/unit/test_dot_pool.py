@@ -1,4 +1,4 @@
-"""The kept dot processes (server/dot.py): drawings in order, a process reused, and one that fails or
+"""The kept dot processes (fsmscope/server/dot.py): drawings in order, a process reused, and one that fails or
 is too slow replaced without taking the next layout down."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ import shutil
 
 import pytest
 
-from server.dot import DotError, DotPool
+from fsmscope.server.dot import DotError, DotPool
 
 pytestmark = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz's dot is not installed (make apt)")
 

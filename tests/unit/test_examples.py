@@ -11,7 +11,7 @@ from fsm.logfiles.log_reader import read_events
 from fsm.logfiles.summary import summarize
 
 from recording_support import EXAMPLES, FAST, cli, load_example, record
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 
 
 def test_foo_bar_loops_three_times_then_ends_in_end(tmp_path):

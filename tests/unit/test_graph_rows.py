@@ -1,4 +1,4 @@
-"""A container's states wrapped into rows (server/graph_rows.py): a machine of a few dozen states is
+"""A container's states wrapped into rows (fsmscope/server/graph_rows.py): a machine of a few dozen states is
 drawn about as wide as a screen, not as a column of boxes no screen shows readable whole."""
 
 from __future__ import annotations
@@ -7,9 +7,9 @@ import re
 
 import fsm
 from fsm.observation import structure
-from server import graph
-from server.graph_rows import ranks
-from server.testing.mission import mission_machine, sequence_machine
+from fsmscope.server import graph
+from fsmscope.server.graph_rows import ranks
+from fsmscope.server.testing.mission import mission_machine, sequence_machine
 
 
 def drawn_size(sm) -> tuple[float, float]:

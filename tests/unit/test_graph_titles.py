@@ -7,8 +7,8 @@ import re
 import xml.etree.ElementTree as ET
 
 import fsm
-from server import graph
-from server.testing.big_machine import big_machine
+from fsmscope.server import graph
+from fsmscope.server.testing.big_machine import big_machine
 
 SVG = "{http://www.w3.org/2000/svg}"
 GRAPHVIZ_NAME = re.compile(r"[no]\d+(->[no]\d+)?")

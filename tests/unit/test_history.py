@@ -1,4 +1,4 @@
-"""A machine's past read from its recording (server/history.py's LogHistory, History.from_log): the
+"""A machine's past read from its recording (fsmscope/server/history.py's LogHistory, History.from_log): the
 status after any event, the seq at a time, pages of events, over real Recorder logs, corrupt ones
 and logs without an index."""
 
@@ -12,9 +12,9 @@ from fsm.observation.status import Status
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from recording_support import record
-from server import history as history_module
+from fsmscope.server import history as history_module
 from fsm.control.controls import Refused
-from server.history import History, LogHistory
+from fsmscope.server.history import History, LogHistory
 from smach_support import counting_machine
 
 ROUNDS = 300

@@ -5,7 +5,7 @@ the simulator. Inside fsm the core imports nothing but itself: it reports throug
 (fsm/core/reporting.py), which observation implements; no extension (ros, logfiles, debugging,
 control) is imported by what it extends. sim never imports
 server; interop (bags, MCAP, Foxglove) and fleet (Zenoh) import neither; server imports sim, interop
-and fleet only in its composition root, the CLI (server/cli/).
+and fleet only in its composition root, the CLI (fsmscope/server/cli/).
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ FSM_ARROWS = {
     "control": {"control", "debugging", "observation"},
 }
 
-COMPOSITION_ROOT = ROOT / "server" / "cli"
+COMPOSITION_ROOT = ROOT / "fsmscope" / "server" / "cli"
 
 
 def imported_modules(path: Path) -> list[tuple[int, str]]:
@@ -56,7 +56,8 @@ def imported_modules(path: Path) -> list[tuple[int, str]]:
 
 
 def python_files(package: str) -> list[Path]:
-    return sorted((ROOT / package).rglob("*.py"))
+    """The files of a package named by its dotted name."""
+    return sorted((ROOT / package.replace(".", "/")).rglob("*.py"))
 
 
 def where(path: Path, line: int, module: str) -> str:
@@ -92,7 +93,8 @@ def test_fsm_imports_only_the_standard_library_and_its_own_lower_layers():
 
 
 # What each package beside fsm must never import: the server composes them, never the reverse.
-NEVER = {"sim": ("server",), "interop": ("server", "sim"), "fleet": ("server", "sim", "interop")}
+SERVER, SIM, INTEROP, FLEET = "fsmscope.server", "fsmscope.sim", "fsmscope.interop", "fsmscope.fleet"
+NEVER = {SIM: (SERVER,), INTEROP: (SERVER, SIM), FLEET: (SERVER, SIM, INTEROP)}
 
 
 @pytest.mark.parametrize("package", sorted(NEVER))
@@ -104,7 +106,7 @@ def test_a_part_never_imports_the_parts_that_compose_it(package):
 
 @pytest.mark.parametrize("package", sorted(NEVER))
 def test_the_server_imports_a_part_only_in_the_composition_root(package):
-    wrong = [arrow for path in python_files("server") if COMPOSITION_ROOT not in path.parents
+    wrong = [arrow for path in python_files(SERVER) if COMPOSITION_ROOT not in path.parents
              for arrow in imports_of(path, package)]
     assert wrong == []
 
@@ -174,7 +176,7 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return sorted(found)
 
 
-@pytest.mark.parametrize("package", ["fsm", "server", "fleet", "interop", "sim"])
+@pytest.mark.parametrize("package", ["fsm", SERVER, FLEET, INTEROP, SIM])
 def test_no_import_cycle_among_a_packages_modules(package):
     assert cycles(import_graph(package)) == []
 

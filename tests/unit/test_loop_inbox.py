@@ -1,10 +1,10 @@
-"""The hand-off from the fleet watcher's threads to the dashboard's event loop (server/cli/fleet_bridge.py)."""
+"""The hand-off from the fleet watcher's threads to the dashboard's event loop (fsmscope/server/cli/fleet_bridge.py)."""
 
 import asyncio
 import concurrent.futures
 import threading
 
-from server.cli.fleet_bridge import LoopInbox
+from fsmscope.server.cli.fleet_bridge import LoopInbox
 
 
 def run_in_thread(work) -> None:

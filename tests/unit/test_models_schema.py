@@ -1,4 +1,4 @@
-"""The REST models of server/models.py say what the schema says (fsm/observation/schema/): the same
+"""The REST models of fsmscope/server/models.py say what the schema says (fsm/observation/schema/): the same
 fields, each allowing null exactly when the schema does, of the same kind of value. A field added to
 or changed in one and not the other fails here."""
 
@@ -10,7 +10,7 @@ import pytest
 from pydantic import BaseModel
 
 from fsm.observation import schema
-from server import control_models, models
+from fsmscope.server import control_models, models
 
 NONE = type(None)
 

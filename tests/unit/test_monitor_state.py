@@ -4,7 +4,7 @@ import time
 
 import fsm as smach
 
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from fsm.ros.monitor_state import MonitorState
 from smach_support import Background, machine
 

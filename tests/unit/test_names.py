@@ -7,11 +7,11 @@ from __future__ import annotations
 import fsm
 import pytest
 
-from fleet import keys
+from fsmscope.fleet import keys
 from fsm.observation import names, schema
-from interop.channels import EVENTS
+from fsmscope.interop.channels import EVENTS
 from node_support import map_in_schema_js, needs_node
-from server.hub import Hub
+from fsmscope.server.hub import Hub
 
 NAMES = ["picker", "pick and place", "robot:arm", "ünïcødé", "x" * 200, "", " lead", "trail ", "task#2",
          "a/b", "*", "$x", "what?", "tab\there", "bell\x07", "del\x7f", "x" * 201, "\u00a0nbsp", "😀" * 200]
@@ -61,12 +61,12 @@ def test_the_hub_makes_a_valid_name_of_an_unusable_one():
 
 @needs_node
 def test_the_page_takes_the_same_names_as_python():
-    """static/schema.js isMachineName, generated from fsm/observation/names.py, mirrors names.is_valid."""
+    """fsmscope/static/schema.js isMachineName, generated from fsm/observation/names.py, mirrors names.is_valid."""
     assert map_in_schema_js("n => m.isMachineName(n)", NAMES) == [names.is_valid(n) for n in NAMES]
 
 
 def test_a_robot_named_with_the_fleets_separator_is_refused_before_it_joins():
-    from fleet.robot import ZenohRobot
+    from fsmscope.fleet.robot import ZenohRobot
 
     with pytest.raises(ValueError, match="a robot's name must not hold ':'"):
         ZenohRobot("lab:1")

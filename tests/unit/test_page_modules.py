@@ -5,7 +5,7 @@ bench/big_machine_browser.py). Dynamic imports (``import(...)``) are loaded when
 import pathlib
 import re
 
-STATIC = pathlib.Path(__file__).resolve().parents[2] / "static"
+STATIC = pathlib.Path(__file__).resolve().parents[2] / "fsmscope" / "static"
 IMPORT = re.compile(r'^\s*(?:import|export)\b[^;]*?\bfrom\s+"\./([\w.]+\.js)"', re.M | re.S)
 PRELOAD = re.compile(r'<link rel="modulepreload" href="([\w.]+\.js)">')
 

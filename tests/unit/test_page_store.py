@@ -1,4 +1,4 @@
-"""The page's one store (static/store.js) and what the notice says of the runs (static/notice.js's
+"""The page's one store (fsmscope/static/store.js) and what the notice says of the runs (fsmscope/static/notice.js's
 RunNotices), run in Node on the events of a real run: subscribers hear which part of the state
 changed, the structure's nodes are indexed again only when it changes, and the notice is the store's
 state (what it says is never read back from the page)."""
@@ -14,7 +14,7 @@ import fsm
 import pytest
 from server_support import nested_machine
 
-STATIC = pathlib.Path(__file__).resolve().parents[2] / "static"
+STATIC = pathlib.Path(__file__).resolve().parents[2] / "fsmscope" / "static"
 NODE = shutil.which("node")
 pytestmark = pytest.mark.skipif(NODE is None, reason="Node.js is not installed")
 

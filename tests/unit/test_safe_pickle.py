@@ -1,4 +1,4 @@
-"""interop.safe_pickle: smach_ros's pickled userdata read as plain data, nothing a pickle names ever run."""
+"""fsmscope.interop.safe_pickle: smach_ros's pickled userdata read as plain data, nothing a pickle names ever run."""
 
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from interop import safe_pickle
+from fsmscope.interop import safe_pickle
 
 
 class Shell:

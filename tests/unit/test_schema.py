@@ -23,7 +23,7 @@ def test_every_event_of_an_observed_run_fits_the_schema():
 
 
 def test_every_event_of_the_examples_fits_the_schema(tmp_path):
-    from server.runner import Runner
+    from fsmscope.server.runner import Runner
 
     for script in sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "..", "examples", "*.py"))):
         log = tmp_path / (os.path.basename(script) + ".jsonl")

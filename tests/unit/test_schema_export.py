@@ -1,10 +1,10 @@
-"""The browser's static/schema.js, the tables of docs/events.md and the frame tables of docs/api.md are
+"""The browser's fsmscope/static/schema.js, the tables of docs/events.md and the frame tables of docs/api.md are
 generated from fsm/observation/schema/ and must not drift from it."""
 
 from __future__ import annotations
 
 from fsm.observation import schema
-from server import schema_export
+from fsmscope.server import schema_export
 
 
 def read(path: str) -> str:

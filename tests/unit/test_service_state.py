@@ -7,7 +7,7 @@ from types import SimpleNamespace
 import fsm as smach
 import pytest
 
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from fsm.ros.bus import default_bus
 from fsm.ros.service_state import ServiceState
 from smach_support import Background, machine, userdata

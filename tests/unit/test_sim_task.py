@@ -20,11 +20,11 @@ pytest.importorskip("mujoco")
 import fsm  # noqa: E402
 from fsm.ros.actionlib import GoalStatus, SimpleActionClient  # noqa: E402
 from fsm.ros.bus import Bus  # noqa: E402
-from server.testing.polling import wait_for  # noqa: E402
+from fsmscope.server.testing.polling import wait_for  # noqa: E402
 
-from sim.demo import SimDemo  # noqa: E402
-from sim.ik import IKSolver, tool_down_rotation  # noqa: E402
-from sim.world import ARM_JOINTS, CUBE_REGION, HOME_Q, TABLE_Z, World, load_model  # noqa: E402
+from fsmscope.sim.demo import SimDemo  # noqa: E402
+from fsmscope.sim.ik import IKSolver, tool_down_rotation  # noqa: E402
+from fsmscope.sim.world import ARM_JOINTS, CUBE_REGION, HOME_Q, TABLE_Z, World, load_model  # noqa: E402
 
 
 @pytest.fixture(autouse=True)
@@ -194,7 +194,7 @@ def test_preempt_during_transport_stops_the_arm(demo_factory, how):
 # ---------------------------------------------------------------- the 3D view
 
 def test_scene_binds_loopback_and_stop_frees_the_port():
-    from sim.scene import start_scene
+    from fsmscope.sim.scene import start_scene
 
     w = World(seed=0).start()
     try:

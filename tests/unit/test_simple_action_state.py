@@ -8,7 +8,7 @@ import fsm as smach
 import pytest
 
 from bus_support import serve, until_preempted
-from server.testing.polling import wait_for
+from fsmscope.server.testing.polling import wait_for
 from fsm.ros.actionlib import GoalStatus
 from fsm.ros.simple_action_state import SimpleActionState
 from smach_support import Background, machine, userdata

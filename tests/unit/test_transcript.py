@@ -98,7 +98,7 @@ def _control_line(event):
     return line.level, line.msg
 
 
-# The expected texts follow static/transcript.js for a control event:
+# The expected texts follow fsmscope/static/transcript.js for a control event:
 # `Control ${action}${params} from ${client}${reason}: ${result}`.
 @pytest.mark.parametrize("event, expected", [
     (_control("preempt", reason="operator"), ("info", "Control preempt from 127.0.0.1 (operator): accepted")),

@@ -1,5 +1,5 @@
 """The words the server and the page share (fsm/observation/vocabularies.py): the page's run state
-(static/schema.js runState, generated beside it) says what the server's says, for every status, and
+(fsmscope/static/schema.js runState, generated beside it) says what the server's says, for every status, and
 the timeline's ticks are of the kinds the page draws."""
 
 from __future__ import annotations
@@ -8,7 +8,7 @@ import itertools
 
 from fsm.observation import vocabularies
 from node_support import map_in_schema_js, needs_node
-from server.timeline import TimelineIndex
+from fsmscope.server.timeline import TimelineIndex
 
 CASES = list(itertools.product([True, False], [None, "done"], [None, {"exc_type": "E"}], [None, True, False]))
 

@@ -16,10 +16,10 @@ One package, one module per concept:
 
 Every producer makes events with ``build`` (the runtime's reporter, the recorder's and the
 publisher's snapshots, the server's control events) and frames with ``messages``; every door an
-event comes in through from outside calls ``validate``. The browser's ``static/schema.js`` (its
+event comes in through from outside calls ``validate``. The browser's ``fsmscope/static/schema.js`` (its
 constants and JSDoc typedefs) and the field tables of ``docs/events.md`` are generated from here
 (``python -m server.schema_export``); a test fails when they differ. The REST models of
-server/models.py are tested against the status, breakpoint and tile shapes.
+fsmscope/server/models.py are tested against the status, breakpoint and tile shapes.
 
 Everything is importable from ``fsm.observation.schema`` itself. Standard library only, like the rest of ``fsm``.
 """

@@ -170,7 +170,7 @@ BODY_POSE = _sized(list_of(NUMBER, "a list of 7 finite numbers (x, y, z, qw, qx,
 MAP_BODY_POSE = object_of(BODY_POSE, "an object of body poses")
 
 
-# Every shape by its typedef's name (static/schema.js has one typedef per shape).
+# Every shape by its typedef's name (fsmscope/static/schema.js has one typedef per shape).
 SHAPES: dict[str, Type] = {}
 
 

@@ -4,7 +4,7 @@ for every message), each a JSON object whose ``type`` says which.
 The page's stream (docs/api.md, "Stream") and the fleet overview's, and the publisher's link to the
 server (docs/api.md, "Ingest"). ``frame.NAME(...)`` makes each, as ``build`` makes events (the
 fields in their order, optional ones by keyword) and ``field_names(NAME)`` names what a reader reads;
-``static/schema.js`` carries their JSDoc typedefs.
+``fsmscope/static/schema.js`` carries their JSDoc typedefs.
 """
 
 from __future__ import annotations

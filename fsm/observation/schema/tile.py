@@ -1,5 +1,5 @@
 """The fleet overview's tile: what an operator scans a fleet for, one per machine a server knows
-(server/overview.py makes them with ``tile``; GET /api/overview and the ``overview`` frame carry them)."""
+(fsmscope/server/overview.py makes them with ``tile``; GET /api/overview and the ``overview`` frame carry them)."""
 
 from __future__ import annotations
 

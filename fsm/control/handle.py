@@ -12,6 +12,7 @@ import time
 from typing import Any, Callable
 
 from fsm.observation import introspection
+from fsm.observation import runtimes
 from fsm.observation import structure
 from fsm.observation.schema import build
 
@@ -48,6 +49,7 @@ class MachineHandle:
         self._thread: threading.Thread | None = None
         self._pending: list[tuple[Any, list[str], dict | None]] = []
         self._hook_installed = False
+        self._between_runs = False  # an original machine's run has ended (its termination callbacks ran)
         self._debug: DebugControl | None = None
 
     def capabilities(self) -> Capabilities:
@@ -59,8 +61,7 @@ class MachineHandle:
         return Capabilities(cannot=cannot)
 
     def is_running(self) -> bool:
-        running = getattr(self.machine, "is_running", None)
-        if callable(running) and running():
+        if runtimes.is_running(self.machine):
             return True
         thread = self._thread
         return thread is not None and thread.is_alive()
@@ -141,12 +142,13 @@ class MachineHandle:
                 raise Refused(404, "no state at path %r" % path)
             if not structure.is_container(container):
                 raise Refused(422, "%r is a state, not a container" % path)
+            self._check_settable(container)
             self._check_states(container, states)
         except Refused as err:
             self.emit_control("initial-state", client, err.message, params=params, path=path)
             raise
         with self._lock:
-            deferred = self.is_running()
+            deferred = self.is_running() and not self._between_runs
             if deferred:
                 self._pending.append((container, states, userdata))
                 self._install_hook()
@@ -170,22 +172,50 @@ class MachineHandle:
             raise Refused(422, "a %s has exactly one initial state" % kind)
 
     @staticmethod
+    def _check_settable(container: Any) -> None:
+        """SMACH's Container leaves set_initial_state unimplemented: a user's own container class may too."""
+        if getattr(type(container).set_initial_state, "__qualname__", "") == "Container.set_initial_state":
+            raise Refused(422, "a %s takes no initial state: its class does not implement set_initial_state"
+                          % type(container).__name__)
+
+    @staticmethod
     def _apply(container: Any, states: list[str], userdata: dict | None) -> None:
-        container.set_initial_state(list(states), userdata if userdata else None)
+        if runtimes.is_original(container):
+            runtimes.set_original_initial_state(container, states, userdata or {})
+        else:
+            container.set_initial_state(list(states), userdata if userdata else None)
 
     def _install_hook(self) -> None:
-        if not self._hook_installed:
-            self._hook_installed = True
+        if self._hook_installed:
+            return
+        self._hook_installed = True
+        if runtimes.is_original(self.machine):
+            # The original takes its initial state before its start callbacks run: a deferred one is
+            # applied as the run ends instead, when the run reads none of it again.
+            self.machine.register_start_cb(self._on_original_start)
+            self.machine.register_termination_cb(self._on_original_end)
+        else:
             introspection.add_global_hook(self._on_top_level_start)
 
     def _on_top_level_start(self, container: Any) -> None:
         """A deferred initial state takes effect as the machine starts its next run."""
-        if container is not self.machine:
-            return
+        if container is self.machine:
+            self._apply_pending()
+
+    def _on_original_start(self, userdata: Any, initial_states: Any) -> None:
+        with self._lock:
+            self._between_runs = False
+
+    def _on_original_end(self, userdata: Any, terminal_states: Any, outcome: Any) -> None:
+        with self._lock:
+            self._between_runs = True
+        self._apply_pending()
+
+    def _apply_pending(self) -> None:
         with self._lock:
             pending, self._pending = self._pending, []
-        for target, states, userdata in pending:
-            self._apply(target, states, userdata)
+            for target, states, userdata in pending:
+                self._apply(target, states, userdata)
 
     # Re-run.
     def start(self, client: str) -> int:

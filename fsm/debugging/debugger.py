@@ -27,8 +27,7 @@ import weakref
 from dataclasses import dataclass
 from typing import Any, Iterable
 
-from ..core import log
-from ..observation import introspection, structure
+from ..observation import introspection, runtimes, structure
 from ..observation.schema import build
 from .breakpoint import Breakpoint, BreakpointError
 from .condition import ConditionError
@@ -81,9 +80,13 @@ class Debugger:
         self._breakpoints: dict[str, tuple[Breakpoint, ...]] = {}
         self._forced: dict[str, tuple[str, str | None]] = {}  # state path: (outcome, by)
         self._holds: list[Hold] = []
+        self._is_shutdown = runtimes.shutdown_check(machine)
         self._bind(None)
         _attached[machine] = self
-        introspection.add_global_hook(self._on_top_level_start)
+        if runtimes.is_original(machine):  # no global hook runs for it: its own start callback tells a new run
+            machine.register_start_cb(self._on_original_start)
+        else:
+            introspection.add_global_hook(self._on_top_level_start)
 
     # What the page shows.
     def holds(self) -> list[dict]:
@@ -234,7 +237,9 @@ class Debugger:
 
     def _hold(self, container: Any, label: str, at: str, outcome: Any, reason: str, detail: str) -> Hold:
         hold = Hold(container._path, label, at, None if outcome is None else str(outcome), reason, detail)
-        container._report_changes()  # what a hold shows is what its condition saw, not the last transition's
+        report_changes = getattr(container, "_report_changes", None)  # fsm's: the original reports on its own
+        if report_changes is not None:
+            report_changes()  # what a hold shows is what its condition saw, not the last transition's
         with self._cond:
             self.mode, self.level = "pause", None  # said by the hold event: a held machine is paused
             self._arm()
@@ -242,7 +247,7 @@ class Debugger:
         self._emit(container._path, action="hold", **{k: v for k, v in hold.to_dict().items() if k != "path"})
         with self._cond:
             while hold.released_by is None:
-                if container.preempt_requested() or log.is_shutdown():
+                if container.preempt_requested() or self._is_shutdown():
                     self._release([hold], "preempt" if container.preempt_requested() else "shutdown")
                     break
                 self._cond.wait(POLL)
@@ -293,11 +298,15 @@ class Debugger:
         stack = [(self.machine, self.root_path)]
         while stack:
             state, path = stack.pop()
-            if state._path is None:
+            if getattr(state, "_path", None) is None:
                 state._path = path
             if structure.is_container(state):
                 state._debugger = debugger
                 stack.extend((child, path + "/" + str(label)) for label, child in structure.children(state).items())
+
+    def _on_original_start(self, userdata: Any, initial_states: Any) -> None:
+        if _attached.get(self.machine) is self:
+            self._on_top_level_start(self.machine)
 
     def _on_top_level_start(self, container: Any) -> None:
         """A new run: the tree may have grown, and no force of the last run applies any more."""

@@ -12,39 +12,21 @@ its module's docstring; a documented fix of fsm (README's table, BEHAVIORS.md's 
 as the difference it is.
 """
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import fsm
 import fsm.core.log
 import pytest
 
+from original_support import loaded_original
+
 pytest.register_assert_rewrite("parity_support")
 from parity_support import Parity  # noqa: E402
-
-ORIGINAL_SRC = Path(__file__).resolve().parents[2].parent / "shared/reference/executive_smach/noetic/smach/src"
 
 
 @pytest.fixture(scope="module")
 def original():
     """The original ``smach`` package, loaded from its source for this module's tests."""
-    init = ORIGINAL_SRC / "smach" / "__init__.py"
-    if not init.exists():
-        pytest.skip("the original SMACH core is not at %s (a copy of shared/ beside the project root)" % ORIGINAL_SRC)
-    before = {name: module for name, module in sys.modules.items() if name == "smach" or name.startswith("smach.")}
-    for name in before:
-        del sys.modules[name]
-    spec = importlib.util.spec_from_file_location("smach", init, submodule_search_locations=[str(init.parent)])
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["smach"] = module
-    try:
-        spec.loader.exec_module(module)
+    with loaded_original() as module:
         yield module
-    finally:
-        for name in [n for n in sys.modules if n == "smach" or n.startswith("smach.")]:
-            del sys.modules[name]
-        sys.modules.update(before)
 
 
 @pytest.fixture

@@ -45,10 +45,13 @@ def shutdown_check(machine: Any) -> Callable[[], bool]:
 
 def is_running(container: Any) -> bool:
     """Whether the container says it runs: fsm's containers and the original's StateMachine have
-    ``is_running()``; the original's Iterator only its flag; its Concurrence says nothing (False)."""
+    ``is_running()``, the original's Iterator only its flag; its Concurrence has neither, and runs
+    while a thread of its children does."""
     running = getattr(container, "is_running", None)
     if callable(running):
         return bool(running())
+    if is_original_concurrence(container):
+        return any(thread.is_alive() for thread in list(getattr(container, "_threads", {}).values()))
     return getattr(container, "_is_running", False) is True
 
 

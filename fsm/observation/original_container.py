@@ -293,7 +293,11 @@ class Watched:
         finally:
             if own is not None and parent is None and rep is not None:
                 rep.root_left()
-            reporting.leave(prev)
+            if prev is not None or parent is None or not parent.concurrent:
+                reporting.leave(prev)
+            # else: a thread the original's Concurrence started for this child, which ends once the
+            # child's outcome is taken: the lines it logs until then (SMACH's wrapping of the
+            # child's exception, its word of a missing outcome) stay the Concurrence's.
 
 
 class PreemptWatched:

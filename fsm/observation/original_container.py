@@ -55,7 +55,7 @@ class ContainerWatch:
         self.concurrent = is_concurrence(container)
         self.userdata = UserdataWatch()
         self._lock = threading.RLock()  # a Concurrence's children call in from their threads
-        self.active: list[str] = []
+        self.active = [s for s in _labels(container.get_active_states()) if s != "None"]  # running when watched?
         self.entered = False  # its execute (wrapped) is running: set on entry, before its start
         self.started = False  # its start callback came in this run
         self.ended = False  # its terminate event was sent in this run

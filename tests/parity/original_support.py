@@ -130,9 +130,27 @@ def preempted_concurrence(side: Side) -> Any:
     return built
 
 
+def iterated(side: Side) -> Any:
+    """ROOT > EACH, an Iterator over three items whose contained state sums them, and stops at 'big'."""
+    sm, k = side.sm, kit(side.sm)
+
+    def add(ud):
+        ud.total = ud.total + ud.item
+        return "big" if ud.total > 4 else "next"
+
+    each = sm.Iterator(outcomes=["big", "exhausted"], input_keys=["total"], output_keys=["total"],
+                       it=[1, 2, 3], it_label="item", exhausted_outcome="exhausted")
+    with each:
+        sm.Iterator.set_contained_state("ADD", k.Out(add, outcomes=["next", "big"], input_keys=["item", "total"],
+                                                     output_keys=["total"]), loop_outcomes=["next"])
+    built = k.machine(["big", "exhausted"], [("EACH", each, {})])
+    built.userdata.total = 0
+    return built
+
+
 SCENARIOS: dict[str, Callable[[Side], Any]] = {
     "loop": loop, "nested": nested, "raising": raising, "raising_child": raising_child, "preempted": preempted,
-    "preempted_concurrence": preempted_concurrence}
+    "preempted_concurrence": preempted_concurrence, "iterated": iterated}
 # Where two threads log at once: the original's Concurrence wakes as its child raises, and logs that
 # it preempts the others while the child's thread words the exception. Their lines are compared in
 # any order.

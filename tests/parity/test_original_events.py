@@ -7,7 +7,7 @@ from fsm.observation import schema
 from fsm.observation.status import rebuild
 
 from original_support import SCENARIOS, run
-from parity_support import normalised
+from parity_support import kit, normalised
 
 
 def foo_bar(smach):
@@ -100,3 +100,34 @@ def test_a_machine_of_the_original_sends_the_events_the_same_machine_sends_on_fs
     ours = run(fsm, SCENARIOS[scenario], tmp_path / "fsm.jsonl")["events"]
     assert _by_path(theirs) == _by_path(ours)
     assert normalised(theirs[0]["root"]) == normalised(ours[0]["root"])
+
+
+def test_where_userdata_events_differ_from_fsms_a_change_is_a_value_that_differs_not_a_write(original, tmp_path):
+    """fsm tracks the keys a state writes; the original's UserData keeps no such record, so a change is
+    a value that differs from the last reported one (original_userdata.py). A list appended to in
+    place is a change on the original (fsm shows it at the container's next start), and a key written
+    with the value it held is none (fsm reports the write)."""
+
+    def scenario(side):
+        k = kit(side.sm)
+
+        def append(ud):
+            ud.items.append(1)
+            return "done"
+
+        def same(ud):
+            ud.n = 5
+            return "done"
+
+        built = k.machine(["done"], [
+            ("APPEND", k.Out(append, io_keys=["items"]), {"done": "SAME"}),
+            ("SAME", k.Out(same, output_keys=["n"]), {})])
+        built.userdata.items, built.userdata.n = [], 5
+        return built
+
+    def changes(sm, log):
+        events = run(sm, scenario, tmp_path / log)["events"]
+        return [(e["kind"], e.get("from"), e.get("changes")) for e in events if e["kind"] in ("userdata", "transition")]
+
+    assert changes(original, "original.jsonl") == [("userdata", None, {"items": [1]}), ("transition", "APPEND", None)]
+    assert changes(fsm, "fsm.jsonl") == [("transition", "APPEND", None), ("userdata", None, {"n": 5})]

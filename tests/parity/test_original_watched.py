@@ -33,6 +33,7 @@ def test_the_runs_compared_are_the_runs_the_scenarios_describe(core, tmp_path):
     assert outcomes["raising"][:2] == ("raised", "InvalidUserCodeError")
     assert outcomes["raising_child"][:2] == ("raised", "InvalidUserCodeError")
     assert outcomes["preempted"] == ("returned", "preempted")
+    assert outcomes["iterated"] == ("returned", "big")
     # The ros2 branch's Concurrence, once its children serviced the preempt, goes on to its outcome map.
     ros2 = "/ros2/" in core.__file__
     assert outcomes["preempted_concurrence"] == ("returned", "done" if ros2 else "preempted")

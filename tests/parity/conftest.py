@@ -16,7 +16,7 @@ import fsm
 import fsm.core.log
 import pytest
 
-from original_support import loaded_original
+from original_core import CORES, loaded_original
 
 pytest.register_assert_rewrite("parity_support")
 from parity_support import Parity  # noqa: E402
@@ -24,9 +24,27 @@ from parity_support import Parity  # noqa: E402
 
 @pytest.fixture(scope="module")
 def original():
-    """The original ``smach`` package, loaded from its source for this module's tests."""
-    with loaded_original() as module:
+    """The original ``smach`` package (noetic-devel), loaded from its source for this module's tests."""
+    with loaded_original("noetic") as module:
         yield module
+
+
+@pytest.fixture(scope="module", params=sorted(CORES))
+def either_core(request):
+    """The original ``smach`` package of each branch in turn (noetic-devel, then ros2), for this module's tests."""
+    with loaded_original(request.param) as module:
+        yield module
+
+
+@pytest.fixture
+def core(either_core):
+    """``either_core`` with its log functions and shutdown check put back after the test (watching a
+    machine wraps them)."""
+    saved = {name: getattr(either_core, name) for name in ("loginfo", "logwarn", "logdebug", "logerr", "is_shutdown")}
+    yield either_core
+    for name, value in saved.items():
+        setattr(either_core, name, value)
+    either_core.Container._construction_stack.clear()
 
 
 @pytest.fixture

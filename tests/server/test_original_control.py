@@ -12,7 +12,7 @@ from fsmscope.server.http_server import ServerThread
 from fsmscope.server.lease import Deadman
 from fsmscope.server.testing.polling import wait_for
 
-from original_support import loaded_original
+from original_core import loaded_original
 from server_support import client
 
 

@@ -12,6 +12,7 @@ import time
 from typing import Any, Callable
 
 from fsm.observation import introspection
+from fsm.observation import original
 from fsm.observation import runtimes
 from fsm.observation import structure
 from fsm.observation.schema import build
@@ -180,16 +181,13 @@ class MachineHandle:
 
     @staticmethod
     def _apply(container: Any, states: list[str], userdata: dict | None) -> None:
-        if runtimes.is_original(container):
-            runtimes.set_original_initial_state(container, states, userdata or {})
-        else:
-            container.set_initial_state(list(states), userdata if userdata else None)
+        runtimes.set_initial_state(container, states, userdata or {})
 
     def _install_hook(self) -> None:
         if self._hook_installed:
             return
         self._hook_installed = True
-        if runtimes.is_original(self.machine):
+        if original.is_original(self.machine):
             # The original takes its initial state before its start callbacks run: a deferred one is
             # applied as the run ends instead, when the run reads none of it again.
             self.machine.register_start_cb(self._on_original_start)

@@ -27,7 +27,7 @@ import weakref
 from dataclasses import dataclass
 from typing import Any, Iterable
 
-from ..observation import introspection, runtimes, structure
+from ..observation import introspection, original, runtimes, structure
 from ..observation.schema import build
 from .breakpoint import Breakpoint, BreakpointError
 from .condition import ConditionError
@@ -83,7 +83,7 @@ class Debugger:
         self._is_shutdown = runtimes.shutdown_check(machine)
         self._bind(None)
         _attached[machine] = self
-        if runtimes.is_original(machine):  # no global hook runs for it: its own start callback tells a new run
+        if original.is_original(machine):  # no global hook runs for it: its own start callback tells a new run
             machine.register_start_cb(self._on_original_start)
         else:
             introspection.add_global_hook(self._on_top_level_start)

@@ -28,9 +28,9 @@ from typing import Any
 from ..core.state import State
 from . import original_log, schema
 from .introspection import Reporter, _never_raising, class_doc
-from .original_container import ContainerWatch, PreemptWatched, Watched, is_concurrence
+from .original_container import ContainerWatch, PreemptWatched, Watched
 from .schema import ABSENT, build
-from .structure import children, is_container
+from .structure import children, is_concurrence, is_container
 
 
 def is_original(machine: Any) -> bool:

@@ -28,11 +28,7 @@ from ..core import reporting
 from .introspection import _words
 from .original_userdata import UserdataWatch
 from .schema import ABSENT, build
-
-
-def is_concurrence(container: Any) -> bool:
-    """The original's Concurrence (or a subclass): its children run at once, on threads of their own."""
-    return hasattr(container, "_child_outcomes") and hasattr(container, "_outcome_map")
+from .structure import is_concurrence
 
 
 def _labels(states: Any) -> list[str]:

@@ -34,12 +34,10 @@ def state_at(root: Any, labels: Iterable[str]) -> Any:
 
 
 def is_concurrence(container: Any) -> bool:
-    """A Concurrence (or a subclass), fsm's or the original smach's: it starts all its children, so it
-    has no initial state to set."""
-    from ..core.concurrence import Concurrence  # here, not at the top: fsm.core imports fsm.observation
-    from .runtimes import is_original_concurrence
-
-    return isinstance(container, Concurrence) or is_original_concurrence(container)
+    """A Concurrence, fsm's or the original smach's (or a subclass of either), told by its shape: an
+    outcome map and its children's outcomes. It starts all its children, so it has no initial state
+    to set."""
+    return hasattr(container, "_child_outcomes") and hasattr(container, "_outcome_map")
 
 
 # The ``structure`` event's tree: nodes with label, path, container and, for a container, children.

@@ -18,7 +18,9 @@ from server_support import client
 
 @pytest.fixture(scope="module")
 def smach():
+    """The original, its log lines kept out of the test's output (they print otherwise)."""
     with loaded_original() as module:
+        module.set_loggers(*[lambda msg: None] * 4)
         yield module
 
 
@@ -94,7 +96,8 @@ def status(http, name):
 
 
 def holds(http, name="loop"):
-    return status(http, name)["debug"]["holds"]
+    debug = status(http, name)["debug"]  # None until a debugger is attached
+    return debug["holds"] if debug is not None else []
 
 
 def controls(http, name, action=None):
@@ -256,6 +259,43 @@ def test_a_preempt_reaches_a_held_original_machine(live_server, smach):
     assert holds(http, "w") == []
 
 
+def test_a_held_original_machine_is_let_go_when_its_own_shutdown_check_says_so(loop, smach):
+    """As smach_ros sets it: the original's is_shutdown is rospy's, and a held machine must not keep the node up."""
+    http, _, result = loop
+    http.post("/api/machines/loop/pause")
+    wait_for(lambda: holds(http))
+    smach.set_shutdown_check(lambda: True)
+    try:
+        wait_for(lambda: "outcome" in result)
+    finally:
+        smach.set_shutdown_check(lambda: False)
+    assert result["outcome"] is None  # the original's loop ends without an outcome at a shutdown
+
+
+def test_a_breakpoint_in_a_container_added_to_an_original_machine_after_arming_holds_at_its_next_run(
+        live_server, smach):
+    sm = visiting(smach)
+    live_server.hub.add_local(sm, name="two")
+    http = client(live_server)
+    never = {"state": "/SM_ROOT/FOO", "at": "after", "when": "visits == ['never']"}
+    assert http.put("/api/machines/two/breakpoints", json={"breakpoints": [never]}).status_code == 200
+    later = smach.StateMachine(outcomes=["done"])
+    with later:
+        smach.StateMachine.add("Z", smach.CBState(lambda ud: "done", outcomes=["done"]), {"done": "done"})
+    with sm:
+        smach.StateMachine.add("LATER", later, {"done": "done"})
+    answer = http.put("/api/machines/two/breakpoints",
+                      json={"breakpoints": [never, {"state": "/SM_ROOT/LATER/Z", "at": "before"}]})
+    assert answer.status_code == 200
+    http.post("/api/machines/two/initial-state", json={"states": ["LATER"]})
+    assert http.post("/api/machines/two/start", json={}).status_code == 202
+    wait_for(lambda: holds(http, "two"))
+    assert (holds(http, "two")[0]["path"], holds(http, "two")[0]["state"]) == ("/SM_ROOT/LATER", "Z")
+    http.put("/api/machines/two/breakpoints", json={"breakpoints": []})
+    http.post("/api/machines/two/resume")
+    wait_for(lambda: status(http, "two")["outcome"] == "done")
+
+
 # Who may control it: the roles, the lease, the deadman, the audit.
 
 def test_a_viewers_control_of_an_original_machine_is_403_and_in_its_audit(loop, live_server):
@@ -303,10 +343,10 @@ def serving_with_deadman(smach, after):
 
 
 def test_a_silent_holder_of_an_original_machines_lease_gets_it_paused_by_the_deadman(smach):
-    with serving_with_deadman(smach, 1.0) as srv:
+    with serving_with_deadman(smach, 1.5) as srv:
         page(srv, "one").post("/api/machines/loop/lease")
         http = client(srv)
-        wait_for(lambda: controls(http, "loop", "deadman"), timeout=4)
+        wait_for(lambda: controls(http, "loop", "deadman"), timeout=5)
         assert controls(http, "loop", "pause")[-1]["client"] == "deadman"
         wait_for(lambda: holds(http))
         assert holds(http)[0]["reason"] == "pause"

@@ -27,7 +27,7 @@ from typing import Any
 
 from ..core.state import State
 from . import original_log, schema
-from .introspection import Reporter, _never_raising, class_doc
+from .introspection import Reporter, _never_raising, class_doc, foreign_reporters
 from .original_container import ContainerWatch, PreemptWatched, Watched
 from .schema import ABSENT, build
 from .structure import children, is_concurrence, is_container
@@ -158,8 +158,14 @@ def _hook(state: Any, rep: OriginalReporter, path: str, parent: ContainerWatch |
     return own
 
 
-def attach(machine: Any, name: str, path: str) -> OriginalReporter:
-    """A reporter for an original machine, its tree hooked and bound to it."""
+def attach(machine: Any, name: str, path: str) -> OriginalReporter | None:
+    """A reporter for a machine of the original SMACH, its tree hooked and bound to it (None for
+    another machine): what ``fsm.attach`` makes for one."""
+    if not is_original(machine):
+        return None
     rep = OriginalReporter(machine, name, path)
     rep.structure()
     return rep
+
+
+foreign_reporters.append(attach)

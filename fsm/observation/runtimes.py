@@ -27,14 +27,17 @@ def shutdown_check(machine: Any) -> Callable[[], bool]:
 
 
 def is_running(container: Any) -> bool:
-    """Whether the container says it runs: fsm's containers and the original's StateMachine have
-    ``is_running()``, the original's Iterator only its flag; its Concurrence has neither, and runs
-    while a thread of its children does."""
+    """Whether the container runs. fsm's say it (``is_running()``). An original one's ``execute``, as
+    the watch fsmscope wraps it in says it (fsm/observation/original_container.py): the ros2 branch's
+    StateMachine keeps ``is_running()`` true after a run that raised, the Iterator's flag (both
+    branches) too, and the Concurrence has neither. A run that began before the watch (a machine
+    attached while it runs) is told by its own flag."""
+    watch = getattr(container, "_fsm_watch", None) if is_original(container) else None
+    if watch is not None and (watch.entered or watch.ended):
+        return watch.entered
     running = getattr(container, "is_running", None)
     if callable(running):
         return bool(running())
-    if is_concurrence(container):
-        return any(thread.is_alive() for thread in list(getattr(container, "_threads", {}).values()))
     return getattr(container, "_is_running", False) is True
 
 

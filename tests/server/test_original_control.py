@@ -16,10 +16,10 @@ from original_core import loaded_original
 from server_support import client
 
 
-@pytest.fixture(scope="module")
-def smach():
-    """The original, its log lines kept out of the test's output (they print otherwise)."""
-    with loaded_original() as module:
+@pytest.fixture(scope="module", params=["noetic", "ros2"])
+def smach(request):
+    """The original of each branch in turn, its log lines kept out of the test's output (they print otherwise)."""
+    with loaded_original(request.param) as module:
         module.set_loggers(*[lambda msg: None] * 4)
         yield module
 
@@ -162,6 +162,27 @@ def test_start_runs_a_finished_original_machine_again(live_server, smach):
     assert http.post("/api/machines/two/start", json={}).status_code == 202
     wait_for(lambda: status(http, "two")["run"] != first_run and status(http, "two")["outcome"] == "done")
     assert sm.userdata.visits == ["FOO", "BAR", "FOO", "BAR"]
+
+
+def test_start_runs_an_original_machine_again_after_a_run_that_raised(live_server, smach):
+    """The ros2 branch's StateMachine says it still runs after a run that raised (its execute has no finally)."""
+    fail = {"now": True}
+
+    def maybe_raise(ud):
+        if fail["now"]:
+            raise ValueError("boom")
+        return "go"
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        smach.StateMachine.add("RISKY", smach.CBState(maybe_raise, outcomes=["go"]), {"go": "done"})
+    live_server.hub.add_local(sm, name="risky")
+    with pytest.raises(smach.InvalidUserCodeError):
+        sm.execute()
+    fail["now"] = False
+    http = client(live_server)
+    assert http.post("/api/machines/risky/start", json={}).status_code == 202
+    wait_for(lambda: status(http, "risky")["outcome"] == "done")
 
 
 def test_an_initial_state_set_while_the_original_machine_runs_takes_effect_at_its_next_run(live_server, smach):

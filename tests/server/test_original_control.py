@@ -6,8 +6,10 @@ import contextlib
 import threading
 import time
 
+import fsm
 import httpx
 import pytest
+from fsmscope import Publisher
 from fsmscope.server.http_server import ServerThread
 from fsmscope.server.lease import Deadman
 from fsmscope.server.testing.polling import wait_for
@@ -315,6 +317,44 @@ def test_a_breakpoint_in_a_container_added_to_an_original_machine_after_arming_h
     http.put("/api/machines/two/breakpoints", json={"breakpoints": []})
     http.post("/api/machines/two/resume")
     wait_for(lambda: status(http, "two")["outcome"] == "done")
+
+
+@contextlib.contextmanager
+def published(live_server, sm):
+    """``sm`` published to the server by a Publisher (in this process, over a real websocket): the
+    controls reach it as control frames, applied by the same handle; yields its run's thread and result."""
+    publisher = Publisher(live_server.base_url, live_server.token)
+    try:
+        fsm.attach(sm, publisher, name="remote")
+        assert publisher.connected.wait(5)
+        thread, result = run_in_thread(sm)
+        wait_for(lambda: any(m["name"] == "remote" and m["running"]
+                             for m in client(live_server).get("/api/machines").json()))
+        yield thread, result
+    finally:
+        publisher.close()
+
+
+def test_a_published_original_machine_is_paused_and_forced_from_the_page(live_server, smach):
+    sm, _ = looping(smach)
+    with published(live_server, sm) as (thread, result):
+        http = client(live_server)
+        assert http.post("/api/machines/remote/pause").status_code == 202
+        wait_for(lambda: holds(http, "remote"))
+        state = "/SM_ROOT/" + holds(http, "remote")[0]["state"]
+        assert http.post("/api/machines/remote/force", json={"state": state, "outcome": "stop"}).status_code == 202
+        assert http.post("/api/machines/remote/resume").status_code == 202
+        thread.join(5)
+        assert result["outcome"] == "done"
+
+
+def test_a_published_original_machine_is_preempted_from_the_page(live_server, smach):
+    sm, entered, _ = waiting(smach)
+    with published(live_server, sm) as (thread, result):
+        assert entered.wait(5)
+        assert client(live_server).post("/api/machines/remote/preempt", json={}).status_code == 202
+        thread.join(5)
+        assert result["outcome"] == "preempted"
 
 
 # Who may control it: the roles, the lease, the deadman, the audit.

@@ -293,11 +293,13 @@ class Watched:
         finally:
             if own is not None and parent is None and rep is not None:
                 rep.root_left()
-            if prev is not None or parent is None or not parent.concurrent:
+            if prev is None and parent is not None and parent.concurrent and rep is not None:
+                # A thread the original's Concurrence started for this child, which ends once the
+                # child's outcome is taken: the lines it logs until then (SMACH's wrapping of the
+                # child's exception, its word of a missing outcome) are the Concurrence's.
+                reporting.enter(rep, parent.path)
+            else:
                 reporting.leave(prev)
-            # else: a thread the original's Concurrence started for this child, which ends once the
-            # child's outcome is taken: the lines it logs until then (SMACH's wrapping of the
-            # child's exception, its word of a missing outcome) stay the Concurrence's.
 
 
 class PreemptWatched:

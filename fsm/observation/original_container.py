@@ -259,15 +259,16 @@ class Watched:
         self.parent: ContainerWatch | None = None  # its container's watch (None: the root)
         self.label = ""
         self.own: ContainerWatch | None = None  # its own watch, when it is a container
+        self.root = False  # it is the watched machine's root: its call is a run
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
-        parent, own, label = self.parent, self.own, self.label
+        parent, own, label, root = self.parent, self.own, self.label, self.root
         watch = own if own is not None else parent
         rep = watch.rep if watch is not None else None
         prev = reporting.enter(rep, watch.path) if rep is not None else reporting.NOT_ENTERED
         try:
             if own is not None:
-                if parent is None and rep is not None:
+                if root and rep is not None:
                     rep.root_entered()
                 own.entering()
             container = parent.container if parent is not None else None
@@ -291,7 +292,7 @@ class Watched:
                 parent.returned(label, outcome)
             return outcome
         finally:
-            if own is not None and parent is None and rep is not None:
+            if root and rep is not None:
                 rep.root_left()
             if prev is None and parent is not None and parent.concurrent and rep is not None:
                 # A thread the original's Concurrence started for this child, which ends once the

@@ -137,24 +137,28 @@ def _describe(state: Any, label: str, path: str, rep: OriginalReporter, parent: 
 
 def _hook(state: Any, rep: OriginalReporter, path: str, parent: ContainerWatch | None, label: str,
           container: bool) -> ContainerWatch | None:
-    """Bind ``state`` to ``rep`` at ``path`` (hooking it the first time); returns its own watch if a container."""
-    state._reporter = rep
-    state._path = path
+    """Bind ``state`` to ``rep`` at ``path`` (hooking it the first time); returns its own watch if a
+    container. A state that takes no attribute (``__slots__``) is described, not watched."""
+    try:
+        state._reporter = rep
+        state._path = path
+    except AttributeError:
+        return None
     own = None
     if container:
         own = getattr(state, "_fsm_watch", None)
         if own is None:
             own = state._fsm_watch = ContainerWatch(state)
             state._report_changes = own.report_changes  # what fsm's debugger calls before a hold
-        own.bind(rep, path, parent is None)
+        own.bind(rep, path, path == rep.root_path)
     execute = state.execute
     if not isinstance(execute, Watched):
         execute = state.execute = Watched(state, execute)
-    execute.parent, execute.label, execute.own = parent, label, own
-    if container and not isinstance(state.request_preempt, PreemptWatched):
-        state.request_preempt = PreemptWatched(state, state.request_preempt, "requested")
-    if not isinstance(state.service_preempt, PreemptWatched):
-        state.service_preempt = PreemptWatched(state, state.service_preempt, "serviced")
+    execute.parent, execute.label, execute.own, execute.root = parent, label, own, path == rep.root_path
+    for name, phase in (("request_preempt", "requested"), ("service_preempt", "serviced")):
+        method = getattr(state, name, None)
+        if method is not None and not isinstance(method, PreemptWatched) and (container or phase == "serviced"):
+            setattr(state, name, PreemptWatched(state, method, phase))
     return own
 
 

@@ -52,6 +52,7 @@ class ContainerWatch:
         self.userdata = UserdataWatch()
         self._lock = threading.RLock()  # a Concurrence's children call in from their threads
         self.active = [s for s in _labels(container.get_active_states()) if s != "None"]  # it may be running
+        self.entered = False  # its execute (wrapped) runs: whether it runs, for its controls (runtimes.is_running)
         self.started = False  # its start callback came in this run
         self.ended = False  # its terminate event was sent in this run
         self.last: tuple[str, str] | None = None  # the (label, outcome) a child returned last
@@ -146,10 +147,11 @@ class ContainerWatch:
 
     def entering(self) -> None:
         """Its own ``execute`` begins (before its start callback, if it gets that far)."""
-        self.started, self.ended = False, False
+        self.entered, self.started, self.ended = True, False, False
 
     def left(self, exc: BaseException | None) -> None:
         """Its own ``execute`` ended: raising ``exc``, or without a terminate (no outcome)."""
+        self.entered = False
         if self.ended:
             return
         self.ended = True

@@ -63,8 +63,8 @@ def visiting(smach):
     return sm
 
 
-def waiting(smach):
-    """One state of the original that waits until preempted (then 'preempted') or released (then 'done')."""
+def waiter(smach):
+    """A state of the original that waits until preempted (then 'preempted') or released (then 'done')."""
     entered, release = threading.Event(), threading.Event()
 
     class Wait(smach.State):
@@ -80,9 +80,15 @@ def waiting(smach):
                 time.sleep(0.005)
             return "done"
 
+    return Wait(), entered, release
+
+
+def waiting(smach):
+    """WAIT (``waiter``) alone in a StateMachine of the original."""
+    wait, entered, release = waiter(smach)
     sm = smach.StateMachine(outcomes=["done", "preempted"])
     with sm:
-        smach.StateMachine.add("WAIT", Wait(), {"done": "done", "preempted": "preempted"})
+        smach.StateMachine.add("WAIT", wait, {"done": "done", "preempted": "preempted"})
     return sm, entered, release
 
 
@@ -133,6 +139,20 @@ def test_the_pages_preempt_ends_a_running_original_machine_preempted(live_server
     thread.join(5)
     assert result["outcome"] == "preempted"
     wait_for(lambda: status(client(live_server), "w")["outcome"] == "preempted")
+
+
+def test_the_pages_preempt_reaches_an_original_machine_whose_top_is_a_concurrence(live_server, smach):
+    """The original's Concurrence has no is_running(): that it runs is what the watch around its execute says."""
+    wait, entered, _ = waiter(smach)
+    split = smach.Concurrence(outcomes=["done", "preempted"], default_outcome="done")
+    with split:
+        smach.Concurrence.add("WAIT", wait)
+    live_server.hub.add_local(split, name="split")
+    thread, result = run_in_thread(split)
+    assert entered.wait(5)
+    assert client(live_server).post("/api/machines/split/preempt", json={}).status_code == 202
+    thread.join(5)
+    assert not thread.is_alive() and "outcome" in result
 
 
 def test_preempt_of_a_finished_original_machine_is_409(live_server, smach):

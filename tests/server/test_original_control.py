@@ -355,6 +355,54 @@ def published(live_server, sm):
         publisher.close()
 
 
+def split_machine(smach, left):
+    """SPLIT, an original Concurrence of ``left`` and RIGHT (returns 'done' at once), in a StateMachine;
+    'done' when both are done."""
+    sm = smach.StateMachine(outcomes=["done", "other", "preempted"])
+    with sm:
+        split = smach.Concurrence(outcomes=["done", "other", "preempted"], default_outcome="other",
+                                  outcome_map={"done": {"LEFT": "done", "RIGHT": "done"}})
+        with split:
+            smach.Concurrence.add("LEFT", left)
+            smach.Concurrence.add("RIGHT", smach.CBState(lambda ud: "done", outcomes=["done"]))
+        smach.StateMachine.add("SPLIT", split, {"done": "done", "other": "other", "preempted": "preempted"})
+    return sm
+
+
+def test_a_child_of_an_original_concurrence_held_before_it_runs_blocks_no_other(live_server, smach):
+    """The original's Concurrence runs a child with no lock held: while RIGHT holds, LEFT runs on to
+    its end, and holds there in turn (a held machine is paused) until resumed."""
+    left, _, release = waiter(smach)
+    sm = split_machine(smach, left)
+    live_server.hub.add_local(sm, name="split")
+    http = client(live_server)
+    http.put("/api/machines/split/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/SPLIT/RIGHT"}]})
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "split"))
+    release.set()
+    wait_for(lambda: len(holds(http, "split")) == 2)
+    assert sorted((h["state"], h["at"], h["reason"]) for h in holds(http, "split")) == [
+        ("LEFT", "after", "pause"), ("RIGHT", "before", "breakpoint")]
+    http.put("/api/machines/split/breakpoints", json={"breakpoints": []})
+    http.post("/api/machines/split/resume")
+    thread.join(5)
+    assert result["outcome"] == "done"
+
+
+def test_a_preempt_reaches_an_original_machine_held_inside_its_concurrence(live_server, smach):
+    left, entered, _ = waiter(smach)
+    sm = split_machine(smach, left)
+    live_server.hub.add_local(sm, name="split")
+    http = client(live_server)
+    http.put("/api/machines/split/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/SPLIT/RIGHT"}]})
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "split"))
+    assert entered.wait(5)
+    assert http.post("/api/machines/split/preempt", json={}).status_code == 202
+    thread.join(5)
+    assert not thread.is_alive() and holds(http, "split") == []
+
+
 def test_a_published_original_machine_is_paused_and_forced_from_the_page(live_server, smach):
     sm, _ = looping(smach)
     with published(live_server, sm) as (thread, result):

@@ -1,0 +1,168 @@
+"""The debugger of a machine of the original smach, against a real uvicorn: pause, step, breakpoints
+with conditions before and after, forced outcomes, a preempt of a held machine, its Concurrence's
+children holding each on its own, and the same of one published from its own process
+(docs/debugging.md, "Machines of the original smach")."""
+
+from fsmscope.server.testing.polling import wait_for
+
+from original_control_support import (holds, loop, looping, published, run_in_thread, smach,  # noqa: F401
+                                      split_machine, status, visiting, waiter, waiting)
+from server_support import client
+
+
+def test_pause_holds_an_original_machine_and_resume_lets_it_finish(loop):
+    http, stop, result = loop
+    assert http.post("/api/machines/loop/pause").status_code == 202
+    wait_for(lambda: holds(http))
+    [hold] = holds(http)
+    assert (hold["at"], hold["reason"]) == ("after", "pause")
+    stop.set()
+    assert http.post("/api/machines/loop/resume").status_code == 202
+    wait_for(lambda: result.get("outcome") == "done")
+
+
+def test_a_step_lets_one_transition_of_a_paused_original_machine_happen(loop):
+    http, _, _ = loop
+    http.post("/api/machines/loop/pause")
+    wait_for(lambda: holds(http))
+    before = holds(http)[0]["state"]
+    assert http.post("/api/machines/loop/step").status_code == 202
+    wait_for(lambda: holds(http) and holds(http)[0]["reason"] == "step")
+    assert holds(http)[0]["state"] == {"A": "B", "B": "A"}[before]
+
+
+def test_a_conditional_breakpoint_before_a_state_holds_the_original_machine_there(loop):
+    http, _, _ = loop
+    answer = http.put("/api/machines/loop/breakpoints",
+                      json={"breakpoints": [{"state": "/SM_ROOT/A", "at": "before", "when": "n >= 6"}]})
+    assert answer.status_code == 200
+    wait_for(lambda: holds(http))
+    [hold] = holds(http)
+    assert (hold["state"], hold["at"], hold["detail"]) == ("A", "before", "hit breakpoint before A when n >= 6")
+    assert status(http, "loop")["containers"]["/SM_ROOT"]["userdata"]["n"] >= 6
+
+
+def test_a_conditional_breakpoint_after_a_state_holds_the_original_machine_with_its_outcome(loop):
+    http, _, _ = loop
+    http.put("/api/machines/loop/breakpoints",
+             json={"breakpoints": [{"state": "/SM_ROOT/B", "at": "after", "outcome": "go", "when": "n >= 4"}]})
+    wait_for(lambda: holds(http))
+    [hold] = holds(http)
+    assert (hold["state"], hold["at"], hold["outcome"]) == ("B", "after", "go")
+    assert hold["detail"] == "hit breakpoint after B with outcome 'go' when n >= 4"
+
+
+def test_a_forced_outcome_replaces_what_the_held_original_state_returned(loop):
+    http, _, result = loop
+    http.post("/api/machines/loop/pause")
+    wait_for(lambda: holds(http))
+    state = "/SM_ROOT/" + holds(http)[0]["state"]
+    assert http.post("/api/machines/loop/force", json={"state": state, "outcome": "stop"}).status_code == 202
+    http.post("/api/machines/loop/resume")
+    wait_for(lambda: result.get("outcome") == "done")  # 'stop' ends it: the loop was never told to stop
+
+
+def test_a_preempt_reaches_a_held_original_machine(live_server, smach):
+    sm, entered, release = waiting(smach)
+    live_server.hub.add_local(sm, name="w")
+    http = client(live_server)
+    http.put("/api/machines/w/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/WAIT", "at": "before"}]})
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "w"))
+    assert http.post("/api/machines/w/preempt", json={}).status_code == 202
+    thread.join(5)
+    assert result["outcome"] == "preempted"
+    assert holds(http, "w") == []
+
+
+def test_a_held_original_machine_is_let_go_when_its_own_shutdown_check_says_so(loop, smach):
+    """As smach_ros sets it: the original's is_shutdown is rospy's, and a held machine must not keep the node up."""
+    http, _, result = loop
+    http.post("/api/machines/loop/pause")
+    wait_for(lambda: holds(http))
+    smach.set_shutdown_check(lambda: True)
+    try:
+        wait_for(lambda: "outcome" in result)
+    finally:
+        smach.set_shutdown_check(lambda: False)
+    assert result["outcome"] is None  # the original's loop ends without an outcome at a shutdown
+
+
+def test_a_breakpoint_in_a_container_added_to_an_original_machine_after_arming_holds_at_its_next_run(
+        live_server, smach):
+    sm = visiting(smach)
+    live_server.hub.add_local(sm, name="two")
+    http = client(live_server)
+    never = {"state": "/SM_ROOT/FOO", "at": "after", "when": "visits == ['never']"}
+    assert http.put("/api/machines/two/breakpoints", json={"breakpoints": [never]}).status_code == 200
+    later = smach.StateMachine(outcomes=["done"])
+    with later:
+        smach.StateMachine.add("Z", smach.CBState(lambda ud: "done", outcomes=["done"]), {"done": "done"})
+    with sm:
+        smach.StateMachine.add("LATER", later, {"done": "done"})
+    answer = http.put("/api/machines/two/breakpoints",
+                      json={"breakpoints": [never, {"state": "/SM_ROOT/LATER/Z", "at": "before"}]})
+    assert answer.status_code == 200
+    http.post("/api/machines/two/initial-state", json={"states": ["LATER"]})
+    assert http.post("/api/machines/two/start", json={}).status_code == 202
+    wait_for(lambda: holds(http, "two"))
+    assert (holds(http, "two")[0]["path"], holds(http, "two")[0]["state"]) == ("/SM_ROOT/LATER", "Z")
+    http.put("/api/machines/two/breakpoints", json={"breakpoints": []})
+    http.post("/api/machines/two/resume")
+    wait_for(lambda: status(http, "two")["outcome"] == "done")
+
+
+def test_a_child_of_an_original_concurrence_held_before_it_runs_blocks_no_other(live_server, smach):
+    """The original's Concurrence runs a child with no lock held: while RIGHT holds, LEFT runs on to
+    its end, and holds there in turn (a held machine is paused) until resumed."""
+    left, _, release = waiter(smach)
+    sm = split_machine(smach, left)
+    live_server.hub.add_local(sm, name="split")
+    http = client(live_server)
+    http.put("/api/machines/split/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/SPLIT/RIGHT"}]})
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "split"))
+    release.set()
+    wait_for(lambda: len(holds(http, "split")) == 2)
+    assert sorted((h["state"], h["at"], h["reason"]) for h in holds(http, "split")) == [
+        ("LEFT", "after", "pause"), ("RIGHT", "before", "breakpoint")]
+    http.put("/api/machines/split/breakpoints", json={"breakpoints": []})
+    http.post("/api/machines/split/resume")
+    thread.join(5)
+    assert result["outcome"] == "done"
+
+
+def test_a_preempt_reaches_an_original_machine_held_inside_its_concurrence(live_server, smach):
+    left, entered, _ = waiter(smach)
+    sm = split_machine(smach, left)
+    live_server.hub.add_local(sm, name="split")
+    http = client(live_server)
+    http.put("/api/machines/split/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/SPLIT/RIGHT"}]})
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "split"))
+    assert entered.wait(5)
+    assert http.post("/api/machines/split/preempt", json={}).status_code == 202
+    thread.join(5)
+    assert not thread.is_alive() and holds(http, "split") == []
+
+
+def test_a_published_original_machine_is_paused_and_forced_from_the_page(live_server, smach):
+    sm, _ = looping(smach)
+    with published(live_server, sm) as (thread, result):
+        http = client(live_server)
+        assert http.post("/api/machines/remote/pause").status_code == 202
+        wait_for(lambda: holds(http, "remote"))
+        state = "/SM_ROOT/" + holds(http, "remote")[0]["state"]
+        assert http.post("/api/machines/remote/force", json={"state": state, "outcome": "stop"}).status_code == 202
+        assert http.post("/api/machines/remote/resume").status_code == 202
+        thread.join(5)
+        assert result["outcome"] == "done"
+
+
+def test_a_published_original_machine_is_preempted_from_the_page(live_server, smach):
+    sm, entered, _ = waiting(smach)
+    with published(live_server, sm) as (thread, result):
+        assert entered.wait(5)
+        assert client(live_server).post("/api/machines/remote/preempt", json={}).status_code == 202
+        thread.join(5)
+        assert result["outcome"] == "preempted"

@@ -12,11 +12,16 @@ would put them: ours win where both have a package (yaml, pygments).
 from __future__ import annotations
 
 import os
+import re
 import shutil
+import signal
 import subprocess
 import sys
+import threading
+import urllib.parse
 from pathlib import Path
 
+import httpx
 import pytest
 from fsmscope.server.testing.demo_process import free_port
 from fsmscope.server.testing.polling import wait_for
@@ -103,11 +108,10 @@ class Ros1:
         except OSError:
             return False
 
-    def robot(self, script: str, *args: str) -> subprocess.Popen:
-        """``python tests/robots/SCRIPT ARGS...`` as a node of this master, its output (both streams) piped."""
-        return subprocess.Popen([sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args],
-                                env=self.robot_env(), cwd=self.home, stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    def robot(self, script: str, *args: str) -> Robot:
+        """``python tests/robots/SCRIPT ARGS...`` as a node of this master."""
+        return Robot([sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args],
+                     self.robot_env(), self.home)
 
     def rostopic(self, *args: str, timeout: float = 30) -> subprocess.CompletedProcess:
         """The real ``rostopic ARGS...`` against this master."""
@@ -122,3 +126,85 @@ class Ros1:
             except subprocess.TimeoutExpired:
                 self.master.kill()
                 self.master.wait()
+
+
+class Robot:
+    """A robot's process, in a group of its own: ``url``, the dashboard's address it printed first
+    (``dashboard: URL``); ``output``, all it printed (both streams, in order) so far."""
+
+    def __init__(self, argv: list[str], env: dict[str, str], cwd: Path) -> None:
+        self.proc = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                                     text=True, start_new_session=True)
+        self._lines: list[str] = []
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+        try:
+            self.url = wait_for(self._printed_url, 60, interval=0.05, what=lambda: "the robot to print its URL:\n"
+                                + self.output)
+        except (RuntimeError, TimeoutError):
+            self.stop()
+            raise
+
+    def _read(self) -> None:
+        for line in self.proc.stdout:
+            self._lines.append(line)
+
+    @property
+    def output(self) -> str:
+        return "".join(self._lines)
+
+    def _printed_url(self) -> str | None:
+        found = re.search(r"^dashboard: (http://\S+)$", self.output, re.M)
+        if found is None and self.proc.poll() is not None:
+            raise RuntimeError("the robot exited with %d before printing its URL:\n%s" % (self.proc.returncode,
+                                                                                           self.output))
+        return found.group(1) if found else None
+
+    def api(self) -> httpx.Client:
+        """A client of the robot's dashboard, holding the token its URL carries."""
+        base, query = self.url.split("/?", 1)
+        token = urllib.parse.parse_qs(query)["token"][0]
+        return httpx.Client(base_url=base, headers={"Authorization": "Bearer " + token}, timeout=10)
+
+    def outcome(self, timeout: float = 30) -> str:
+        """The top machine's outcome, once the robot printed it (``outcome: OUTCOME``)."""
+        def printed() -> str | None:
+            found = re.search(r"^outcome: (\S+)$", self.output, re.M)
+            return found.group(1) if found else None
+        return wait_for(printed, timeout, interval=0.05, what=lambda: "the robot's outcome:\n" + self.output)
+
+    def stop(self, timeout: float = 20) -> int:
+        """SIGINT, as Ctrl-C or roslaunch would: rospy shuts the node down; returns the exit code."""
+        if self.proc.poll() is None:
+            os.killpg(self.proc.pid, signal.SIGINT)
+            try:
+                self.proc.wait(timeout)
+            except subprocess.TimeoutExpired:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+                self.proc.wait()
+        self._reader.join(5)
+        return self.proc.returncode
+
+
+_ROSPY_LINE = re.compile(r"^\[(INFO|WARN|ERROR|DEBUG)\] \[[0-9.]+\]: (.*)$")
+
+
+def rospy_lines(output: str) -> list[tuple[str, str]]:
+    """``(level, message)`` of each line rospy printed to the console (``[INFO] [TIME]: MESSAGE``); the
+    lines of a message after its first start with a tab (SMACH's userdata keys), as in a transcript."""
+    return logged_lines(output, _ROSPY_LINE)
+
+
+def logged_lines(output: str, first_line: re.Pattern) -> list[tuple[str, str]]:
+    """``(level, message)`` of each message in ``output`` whose first line ``first_line`` matches (its
+    groups: the level, the text); its next lines are those that follow it starting with a tab."""
+    lines: list[tuple[str, str]] = []
+    in_message = False
+    for text in output.splitlines():
+        found = first_line.match(text)
+        if found:
+            lines.append((found.group(1).strip().lower(), found.group(2)))
+        elif in_message and text.startswith("\t"):
+            lines[-1] = (lines[-1][0], lines[-1][1] + "\n" + text)
+        in_message = bool(found) or (in_message and text.startswith("\t"))
+    return lines

@@ -57,9 +57,8 @@ def generate_smach_msgs(out: Path) -> Path:
     msg_dir = NOETIC / "smach_msgs" / "msg"
     package = out / "smach_msgs"
     common = ["-p", "smach_msgs", "-o", str(package / "msg")]
-    for msg in sorted(msg_dir.glob("*.msg")):
-        subprocess.run(["/usr/bin/python3", GENMSG_PY, *common, "-Ismach_msgs:%s" % msg_dir,
-                        "-Istd_msgs:%s" % STD_MSGS, str(msg)], check=True, capture_output=True)
+    subprocess.run(["/usr/bin/python3", GENMSG_PY, *common, "-Ismach_msgs:%s" % msg_dir, "-Istd_msgs:%s" % STD_MSGS,
+                    *map(str, sorted(msg_dir.glob("*.msg")))], check=True, capture_output=True)
     subprocess.run(["/usr/bin/python3", GENMSG_PY, "--initpy", *common], check=True, capture_output=True)
     (package / "__init__.py").touch()
     return out
@@ -113,10 +112,10 @@ class Ros1:
         return Robot([sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args],
                      self.robot_env(), self.home)
 
-    def rostopic(self, *args: str, timeout: float = 30) -> subprocess.CompletedProcess:
-        """The real ``rostopic ARGS...`` against this master."""
-        return subprocess.run(["rostopic", *args], env=self.ros_env(), capture_output=True, text=True,
-                              timeout=timeout)
+    def rostopic(self, *args: str) -> subprocess.Popen:
+        """The real ``rostopic ARGS...`` against this master, started (its output piped, as text)."""
+        return subprocess.Popen(["rostopic", *args], env=self.ros_env(), stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, text=True)
 
     def stop(self) -> None:
         if self.master is not None and self.master.poll() is None:

@@ -1,7 +1,8 @@
 """A ROS 1 robot as its people write it: the original SMACH with smach_ros on rospy, and fsmscope's
 IntrospectionServer where smach_ros's stood. Run by tests/ros1/ against a real rosmaster
 (tests/ros1_support.py) as ``ros1_robot.py RECORDING``: it prints the dashboard's URL, records the
-run, and spins after the machine ends until it is stopped, as a robot's node does.
+run, and spins until it is stopped, as a robot's node does (the machine runs in a thread of its own,
+smach_ros's preempt handler preempting it on shutdown).
 
 ROBOT
   PATROL (Concurrence: whichever child ends first ends it)
@@ -11,6 +12,7 @@ ROBOT
   PATROL 'stopped' (MONITOR_STOP 'invalid') -> DOCK -> 'stopped'
 """
 import sys
+import threading
 
 import fsm
 import rospy
@@ -98,13 +100,19 @@ def build():
     return robot
 
 
+def run(machine):
+    print("outcome: %s" % machine.execute(), flush=True)
+
+
 rospy.init_node("fsmscope_robot")
 sm = build()
-fsm.attach(sm, fsm.Recorder(sys.argv[1], new=True))
 sis = IntrospectionServer("robot", sm, "/SM_ROOT")
 sis.start()
+fsm.attach(sm, fsm.Recorder(sys.argv[1], new=True))
 print("dashboard: %s" % sis.url, flush=True)
-outcome = sm.execute()
-print("outcome: %s" % outcome, flush=True)
+smach_ros.set_preempt_handler(sm)  # a shutdown (Ctrl-C) preempts the machine, and waits for it to end
+runner = threading.Thread(target=run, args=(sm,))
+runner.start()
 rospy.spin()
+runner.join()
 sis.stop()

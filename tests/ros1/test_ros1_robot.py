@@ -33,14 +33,16 @@ def stopped(ros) -> Run:
     try:
         wait_for(lambda: "'RETRY':'again'-->'SCAN'" in robot.output, 30, interval=0.05,
                  what=lambda: "the robot to retry a scan:\n" + robot.output)
-        published = ros.rostopic("pub", "-1", "/sm_stop", "std_msgs/Empty")
-        assert published.returncode == 0, published.stdout + published.stderr
+        # `pub -1` latches the message and waits 3 s for subscribers before it exits: the run goes on meanwhile.
+        publisher = ros.rostopic("pub", "-1", "/sm_stop", "std_msgs/Empty")
         outcome = robot.outcome()
         with robot.api() as api:
             answer = api.get("/api/machines/robot/history", params={"kinds": "transition,terminate", "limit": 10000})
             assert answer.status_code == 200, answer.text
     finally:
         robot.stop()
+    published = publisher.communicate(timeout=30)[0]
+    assert publisher.returncode == 0, published
     return Run(outcome, answer.json()["events"], robot.output, recording)
 
 

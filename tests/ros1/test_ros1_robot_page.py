@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 from fsmscope.server.testing.polling import wait_for
 
-from browser_support import ACTIVE_LEAF, page_at
+from browser_support import page_at
 
 pytestmark = pytest.mark.browser  # real Chromium, as the browser layer's tests
 
@@ -28,8 +28,9 @@ def page(browser, robot):
 
 
 def active_in_work(page) -> str | None:
-    leaf = page.evaluate(ACTIVE_LEAF)
-    return leaf if leaf and leaf.startswith(WORK) else None
+    """The id of the state of WORK the graph shows active (MONITOR_STOP, beside it, is active throughout)."""
+    return page.evaluate("""(work) => [...document.querySelectorAll('#graph g.node.active')].map(g => g.id)
+                                          .find(id => id.startsWith(work)) || null""", WORK)
 
 
 def test_the_page_follows_the_robots_patrol_live(page):

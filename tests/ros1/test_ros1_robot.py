@@ -1,7 +1,7 @@
 """A real ROS 1 robot (tests/robots/ros1_robot.py: the original SMACH with smach_ros on rospy, a real
 rosmaster) watched by fsmscope's IntrospectionServer: a message on /sm_stop sent with the real
-``rostopic pub`` ends its patrol, the dashboard sees the MonitorState's outcome as what ended it, and
-the run's recording replays as the robot's own console printed it."""
+``rostopic pub`` ends its patrol, the dashboard sees the MonitorState's outcome as what ended it and
+the rounds its userdata counted, and the run's recording replays as the robot's own console printed it."""
 
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ from ros1_support import Robot, logged_lines, rospy_lines
 class Run:
     outcome: str
     events: list[dict]  # the transitions and terminations the dashboard served while the robot lived
+    userdata: dict  # {container path: its userdata} as the dashboard showed it at the end
     console: str  # all the robot printed
     recording: Path
 
@@ -39,11 +40,13 @@ def stopped(ros) -> Run:
         with robot.api() as api:
             answer = api.get("/api/machines/robot/history", params={"kinds": "transition,terminate", "limit": 10000})
             assert answer.status_code == 200, answer.text
+            status = api.get("/api/machines/robot/status").json()
     finally:
         robot.stop()
     published = publisher.communicate(timeout=30)[0]
     assert publisher.returncode == 0, published
-    return Run(outcome, answer.json()["events"], robot.output, recording)
+    userdata = {path: container["userdata"] for path, container in status["containers"].items()}
+    return Run(outcome, answer.json()["events"], userdata, robot.output, recording)
 
 
 def test_a_message_on_sm_stop_from_rostopic_ends_the_patrol_through_the_monitor_state(stopped):
@@ -55,6 +58,13 @@ def test_a_message_on_sm_stop_from_rostopic_ends_the_patrol_through_the_monitor_
         "terminate", "stopped", {"MONITOR_STOP": "invalid", "WORK": "preempted"})
     top = [(e["kind"], e.get("from"), e["outcome"], e.get("to")) for e in stopped.events if e["path"] == "/SM_ROOT"]
     assert top == [("transition", "PATROL", "stopped", "DOCK"), ("terminate", None, "stopped", None)]
+
+
+def test_the_dashboard_shows_the_rounds_the_robots_userdata_counted(stopped):
+    rounds = stopped.console.count("'MOVE':'arrived'-->'SCAN'")
+    assert rounds >= 1
+    assert [stopped.userdata[path]["rounds"] for path in ("/SM_ROOT", "/SM_ROOT/PATROL", "/SM_ROOT/PATROL/WORK")] == [
+        rounds] * 3
 
 
 # A line of `fsmscope replay --no-time`: PATH [ LEVEL ] : MESSAGE (fsm/logfiles/transcript.py).

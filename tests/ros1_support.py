@@ -1,5 +1,6 @@
-"""A private ROS 1 for a test: a real ``rosmaster`` on a free port, and what a node needs to run the
-original SMACH with smach_ros there.
+"""A private ROS 1 for a test: a real ``rosmaster`` on a free port, what a node needs to run the
+original SMACH with smach_ros there, a robot's process as a node of it (the dashboard's URL it
+prints, its outcome, its console) and the real ``rostopic``.
 
 ROS 1 comes from Debian's packages (``make apt``): rospy, rosmaster and rostopic live in Debian's
 Python (/usr/lib/python3/dist-packages). The original SMACH, smach_ros and smach_msgs' .msg files

@@ -197,7 +197,8 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     layers: dict[str | None, list[list[pytest.Item]]] = {}
     for tests in sorted(modules.values(), key=len, reverse=True):
         layers.setdefault(layer_of(tests[0]), []).append(tests)
-    in_turns = itertools.zip_longest(*(layers.pop(layer, []) for layer in ("browser", "fleet", "server", "parity", "ros1")))
+    in_turns = itertools.zip_longest(*(layers.pop(layer, [])
+                                       for layer in ("browser", "fleet", "server", "parity", "ros1")))
     ordered = layers.pop("demo", []) + [tests for turn in in_turns for tests in turn if tests]
     ordered += [tests for rest in layers.values() for tests in rest]  # the unit layer
     items[:] = [item for tests in ordered for item in tests]

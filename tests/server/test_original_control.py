@@ -64,6 +64,25 @@ def test_initial_state_with_userdata_then_start_runs_the_original_machine_from_t
     assert status(http, "two")["containers"]["/SM_ROOT"]["userdata"] == {"visits": ["X", "BAR"]}
 
 
+def test_initial_userdata_is_the_containers_and_reaches_a_state_through_its_remapping(live_server, smach):
+    seen = []
+
+    def read(ud):
+        seen.append(ud.goal)
+        return "done"
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        smach.StateMachine.add("READ", smach.CBState(read, outcomes=["done"], input_keys=["goal"]), {"done": "done"},
+                               remapping={"goal": "target"})
+    live_server.hub.add_local(sm, name="remapped")
+    http = client(live_server)
+    assert http.post("/api/machines/remapped/initial-state", json={"userdata": {"target": 7}}).status_code == 200
+    assert http.post("/api/machines/remapped/start", json={}).status_code == 202
+    wait_for(lambda: seen)
+    assert seen == [7] and sm.userdata.target == 7
+
+
 def test_start_runs_a_finished_original_machine_again(live_server, smach):
     sm = visiting(smach)
     live_server.hub.add_local(sm, name="two")

@@ -31,6 +31,36 @@ def test_a_step_lets_one_transition_of_a_paused_original_machine_happen(loop):
     assert holds(http)[0]["state"] == {"A": "B", "B": "A"}[before]
 
 
+def test_a_step_at_the_roots_level_steps_over_what_runs_inside_a_nested_original_machine(live_server, smach):
+    runs = []
+
+    def visit(label):
+        return smach.CBState(lambda ud: runs.append(label) or "go", outcomes=["go"])
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        sub = smach.StateMachine(outcomes=["ok"])
+        with sub:
+            smach.StateMachine.add("X", visit("X"), {"go": "Y"})
+            smach.StateMachine.add("Y", visit("Y"), {"go": "ok"})
+        smach.StateMachine.add("SUB", sub, {"ok": "LAST"})
+        smach.StateMachine.add("LAST", visit("LAST"), {"go": "done"})
+    live_server.hub.add_local(sm, name="nested")
+    http = client(live_server)
+    http.put("/api/machines/nested/breakpoints", json={"breakpoints": [{"state": "/SM_ROOT/SUB/X", "at": "after"}]})
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "nested"))
+    http.put("/api/machines/nested/breakpoints", json={"breakpoints": []})
+    assert http.post("/api/machines/nested/step", json={"level": "/SM_ROOT"}).status_code == 202
+    wait_for(lambda: holds(http, "nested") and holds(http, "nested")[0]["reason"] == "step")
+    [hold] = holds(http, "nested")
+    assert (hold["path"], hold["state"], hold["outcome"]) == ("/SM_ROOT", "SUB", "ok")
+    assert runs == ["X", "Y"]
+    http.post("/api/machines/nested/resume")
+    thread.join(5)
+    assert result["outcome"] == "done" and runs == ["X", "Y", "LAST"]
+
+
 def test_a_conditional_breakpoint_before_a_state_holds_the_original_machine_there(loop):
     http, _, _ = loop
     answer = http.put("/api/machines/loop/breakpoints",

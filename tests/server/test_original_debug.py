@@ -92,6 +92,17 @@ def test_a_forced_outcome_replaces_what_the_held_original_state_returned(loop):
     wait_for(lambda: result.get("outcome") == "done")  # 'stop' ends it: the loop was never told to stop
 
 
+def test_forcing_a_running_original_state_preempts_it_and_its_container_takes_the_forced_outcome(live_server, smach):
+    sm, entered, _ = waiting(smach)
+    live_server.hub.add_local(sm, name="w")
+    thread, result = run_in_thread(sm)
+    assert entered.wait(5)
+    answer = client(live_server).post("/api/machines/w/force", json={"state": "/SM_ROOT/WAIT", "outcome": "done"})
+    assert answer.status_code == 202
+    thread.join(5)
+    assert result["outcome"] == "done"  # WAIT returned 'preempted'
+
+
 def test_a_preempt_reaches_a_held_original_machine(live_server, smach):
     sm, entered, release = waiting(smach)
     live_server.hub.add_local(sm, name="w")

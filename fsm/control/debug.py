@@ -17,7 +17,7 @@ from .controls import Refused
 
 # The HTTP status of each kind of refusal: the request's content is wrong (422), or the machine
 # is not in a state to take it (409).
-STATUS = {"unknown-state": 422, "unknown-outcome": 422, "bad-breakpoint": 422, "not-active": 409,
+STATUS = {"unknown-state": 422, "unknown-outcome": 422, "bad-breakpoint": 422, "not-gated": 422, "not-active": 409,
           "not-paused": 409}
 
 # What records a control: (action, client, result, params=...) -> the control event's seq.

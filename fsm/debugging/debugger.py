@@ -38,7 +38,7 @@ _attached: "weakref.WeakKeyDictionary[Any, Debugger]" = weakref.WeakKeyDictionar
 
 class DebugError(ValueError):
     """A control the machine cannot take; ``problem`` says which kind: unknown-state, unknown-outcome,
-    bad-breakpoint, not-active, not-paused."""
+    bad-breakpoint, not-active, not-paused, not-gated."""
 
     def __init__(self, problem: str, message: str) -> None:
         super().__init__(message)
@@ -125,6 +125,7 @@ class Debugger:
         state = self._state_at(state_path)
         if state is None or state is self.machine:
             raise DebugError("unknown-state", "no state at %r" % state_path)
+        self._check_gated(state, state_path)
         if outcome not in state.get_registered_outcomes():
             raise DebugError("unknown-outcome", "%r is not an outcome of %s (its outcomes: %s)"
                              % (outcome, state_path, sorted(map(str, state.get_registered_outcomes()))))
@@ -140,7 +141,9 @@ class Debugger:
                                  % state_path)
             self._forced[state_path] = (outcome, by)
             self._arm()
-        state.request_preempt()
+        preempt = getattr(state, "request_preempt", None)  # SMACH runs a state without one too
+        if preempt is not None:
+            preempt()
 
     def set_breakpoints(self, specs: Iterable[Any], by: str | None = None) -> list[dict]:
         """Replace every breakpoint; all or none: raises DebugError for the first that cannot be set."""
@@ -153,6 +156,7 @@ class Debugger:
             state = self._state_at(bp.state)
             if state is None or state is self.machine:
                 raise DebugError("unknown-state", "breakpoint %d: no state at %r" % (i, bp.state))
+            self._check_gated(state, bp.state, "breakpoint %d: " % i)
             if bp.outcome is not None and bp.outcome not in state.get_registered_outcomes():
                 raise DebugError("unknown-outcome", "breakpoint %d: %r is not an outcome of %s (its outcomes: %s)"
                                  % (i, bp.outcome, bp.state, sorted(map(str, state.get_registered_outcomes()))))
@@ -286,6 +290,13 @@ class Debugger:
         if rep is not None:
             rep.send(functools.partial(build.debug, **fields), path)
 
+    def _check_gated(self, state: Any, path: str, prefix: str = "") -> None:
+        """The original's containers gate a child through the wrapper of its ``execute``, which a state
+        with ``__slots__`` cannot be given (fsm's containers gate every child themselves)."""
+        if not hasattr(state, "__dict__") and original.is_original(self.machine):
+            raise DebugError("not-gated", "%s%s takes no attribute (__slots__): its execute cannot be wrapped, so "
+                                          "nothing can hold it or force its outcome" % (prefix, path))
+
     def _state_at(self, path: str) -> Any:
         if path == self.root_path:
             return self.machine
@@ -299,7 +310,10 @@ class Debugger:
         while stack:
             state, path = stack.pop()
             if getattr(state, "_path", None) is None:
-                state._path = path
+                try:
+                    state._path = path
+                except AttributeError:  # a state with __slots__ (SMACH runs any object with its interface)
+                    continue
             if structure.is_container(state):
                 state._debugger = debugger
                 stack.extend((child, path + "/" + str(label)) for label, child in structure.children(state).items())

@@ -3,6 +3,7 @@ with conditions before and after, forced outcomes, a preempt of a held machine, 
 children holding each on its own, and the same of one published from its own process
 (docs/debugging.md, "Machines of the original smach")."""
 
+import pytest
 from fsmscope.server.testing.polling import wait_for
 
 from original_control_support import (holds, loop, looping, published, run_in_thread, smach,  # noqa: F401
@@ -151,6 +152,60 @@ def test_a_breakpoint_in_a_container_added_to_an_original_machine_after_arming_h
     http.put("/api/machines/two/breakpoints", json={"breakpoints": []})
     http.post("/api/machines/two/resume")
     wait_for(lambda: status(http, "two")["outcome"] == "done")
+
+
+class Slotted:
+    """SMACH runs any object with a state's interface; this one takes no attribute (``__slots__``)."""
+
+    __slots__ = ()
+
+    def get_registered_outcomes(self):
+        return ("go",)
+
+    def get_registered_input_keys(self):
+        return ()
+
+    def get_registered_output_keys(self):
+        return ()
+
+    def execute(self, ud):
+        return "go"
+
+    def preempt_requested(self):
+        return False
+
+
+def slotted(live_server, smach):
+    """SLOT (``Slotted``) then LAST, an original machine served as 'slotted'; an operator's client."""
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        smach.StateMachine.add("SLOT", Slotted(), {"go": "LAST"})
+        smach.StateMachine.add("LAST", smach.CBState(lambda ud: "done", outcomes=["done"]), {"done": "done"})
+    live_server.hub.add_local(sm, name="slotted")
+    return sm, client(live_server)
+
+
+def test_an_original_machine_with_a_state_that_takes_no_attribute_is_paused_at_the_others(live_server, smach):
+    sm, http = slotted(live_server, smach)
+    assert http.post("/api/machines/slotted/pause").status_code == 202
+    thread, result = run_in_thread(sm)
+    wait_for(lambda: holds(http, "slotted"))
+    assert [(h["state"], h["at"]) for h in holds(http, "slotted")] == [("LAST", "after")]
+    http.post("/api/machines/slotted/resume")
+    thread.join(5)
+    assert result["outcome"] == "done"
+
+
+@pytest.mark.parametrize("method, path, body", [
+    ("PUT", "breakpoints", {"breakpoints": [{"state": "/SM_ROOT/SLOT"}]}),
+    ("POST", "force", {"state": "/SM_ROOT/SLOT", "outcome": "go"}),
+])
+def test_a_breakpoint_or_force_on_a_state_the_original_cannot_let_be_wrapped_is_422_saying_why(
+        live_server, smach, method, path, body):
+    _, http = slotted(live_server, smach)
+    answer = http.request(method, "/api/machines/slotted/" + path, json=body)
+    assert answer.status_code == 422
+    assert "/SM_ROOT/SLOT takes no attribute (__slots__): its execute cannot be wrapped" in answer.json()["detail"]
 
 
 def test_a_child_of_an_original_concurrence_held_before_it_runs_blocks_no_other(live_server, smach):

@@ -267,7 +267,10 @@ class MachineHandle:
 def recall_every_preempt(state: Any) -> None:
     """Clear the preempts a run left behind: one asked of a state just as it returned is never serviced
     (SMACH keeps it), and the next run Start begins would end 'preempted' at that state at once. A
-    container (SMACH's API: ``get_children``) and each of its states, all the way down."""
-    state.recall_preempt()
+    container (SMACH's API: ``get_children``) and each of its states, all the way down; a state
+    without preempt methods (SMACH runs any object with ``execute`` and outcomes) has none to clear."""
+    recall = getattr(state, "recall_preempt", None)
+    if recall is not None:
+        recall()
     for child in state.get_children().values() if hasattr(state, "get_children") else ():
         recall_every_preempt(child)

@@ -185,7 +185,7 @@ class Debugger:
         path = container._path + "/" + label
         forced = self._forced.pop(path, None) if self._forced else None
         if forced is not None:
-            state.recall_preempt()
+            _recall_preempt(state)
             self._emit(container._path, action="forced", state=label, outcome=forced[0], returned=None,
                        by=forced[1])
             return forced[0]
@@ -201,7 +201,7 @@ class Debugger:
         path = container._path + "/" + label
         forced = self._forced.pop(path, None) if self._forced else None
         if forced is not None:
-            state.recall_preempt()
+            _recall_preempt(state)
             self._emit(container._path, action="forced", state=label, outcome=forced[0],
                        returned=None if outcome is None else str(outcome), by=forced[1])
             outcome = forced[0]
@@ -334,6 +334,13 @@ class Debugger:
 def debugger_of(machine: Any) -> Debugger:
     """The machine's debugger, attached on first use (one per machine)."""
     return _attached.get(machine) or Debugger(machine)
+
+
+def _recall_preempt(state: Any) -> None:
+    """The preempt a force asked of ``state``, recalled; SMACH runs a state without preempt methods too."""
+    recall = getattr(state, "recall_preempt", None)
+    if recall is not None:
+        recall()
 
 
 def _within(path: str, level: str) -> bool:

@@ -115,6 +115,33 @@ def test_start_runs_an_original_machine_again_after_a_run_that_raised(live_serve
     wait_for(lambda: status(http, "risky")["outcome"] == "done")
 
 
+def test_start_runs_an_original_machine_holding_a_state_with_nothing_but_execute_and_outcomes(live_server, smach):
+    """SMACH runs any object with a state's interface: no preempt methods, no attributes (``__slots__``)."""
+
+    class Bare:
+        __slots__ = ()
+
+        def get_registered_outcomes(self):
+            return ("go",)
+
+        def get_registered_input_keys(self):
+            return ()
+
+        def get_registered_output_keys(self):
+            return ()
+
+        def execute(self, ud):
+            return "go"
+
+    sm = smach.StateMachine(outcomes=["done"])
+    with sm:
+        smach.StateMachine.add("BARE", Bare(), {"go": "done"})
+    live_server.hub.add_local(sm, name="bare")
+    http = client(live_server)
+    assert http.post("/api/machines/bare/start", json={}).status_code == 202
+    wait_for(lambda: status(http, "bare")["outcome"] == "done")
+
+
 def test_an_initial_state_set_while_the_original_machine_runs_takes_effect_at_its_next_run(live_server, smach):
     sm, stop = looping(smach)
     live_server.hub.add_local(sm, name="loop")

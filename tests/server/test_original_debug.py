@@ -3,6 +3,8 @@ with conditions before and after, forced outcomes, a preempt of a held machine, 
 children holding each on its own, and the same of one published from its own process
 (docs/debugging.md, "Machines of the original smach")."""
 
+import threading
+
 import pytest
 from fsmscope.server.testing.polling import wait_for
 
@@ -206,6 +208,39 @@ def test_a_breakpoint_or_force_on_a_state_the_original_cannot_let_be_wrapped_is_
     answer = http.request(method, "/api/machines/slotted/" + path, json=body)
     assert answer.status_code == 422
     assert "/SM_ROOT/SLOT takes no attribute (__slots__): its execute cannot be wrapped" in answer.json()["detail"]
+
+
+def test_a_force_of_a_state_without_preempt_methods_is_taken_when_it_returns(live_server, smach):
+    entered, release = threading.Event(), threading.Event()
+
+    class Duck:
+        """SMACH runs any object with a state's interface: this one has no preempt methods."""
+
+        def get_registered_outcomes(self):
+            return ("go", "other")
+
+        def get_registered_input_keys(self):
+            return ()
+
+        def get_registered_output_keys(self):
+            return ()
+
+        def execute(self, ud):
+            entered.set()
+            release.wait(5)
+            return "go"
+
+    sm = smach.StateMachine(outcomes=["went", "forced"])
+    with sm:
+        smach.StateMachine.add("DUCK", Duck(), {"go": "went", "other": "forced"})
+    live_server.hub.add_local(sm, name="duck")
+    thread, result = run_in_thread(sm)
+    assert entered.wait(5)
+    answer = client(live_server).post("/api/machines/duck/force", json={"state": "/SM_ROOT/DUCK", "outcome": "other"})
+    assert answer.status_code == 202
+    release.set()
+    thread.join(5)
+    assert result["outcome"] == "forced"
 
 
 def test_a_child_of_an_original_concurrence_held_before_it_runs_blocks_no_other(live_server, smach):

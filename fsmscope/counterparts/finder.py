@@ -7,11 +7,12 @@ Which way is settled once, as the run starts, by whether ``smach`` can be import
   ``actionlib_msgs``, ``std_msgs`` and ``std_srvs`` are fsmscope's counterparts (this folder; names.py
   lists them), always, even where one of them is installed on its own: their states and servers share
   fsm's in-process bus, which a real rospy's services would not be on. The first one imported says so
-  in one line. Another ROS package that is not installed fails naming itself and saying why; one
-  that is installed is imported as it is.
+  in one line.
 * It can (the original SMACH): nothing is replaced. Once it is imported, ``on_original`` is given the
   module (the runner watches its machines); if importing it fails, the error says which smach failed
   and that its own error (a missing dependency, a syntax error) is the reason.
+
+Either way, a ROS module that is not installed (and not covered) fails naming itself and saying why.
 """
 
 from __future__ import annotations
@@ -32,12 +33,13 @@ NOTICE = ("smach is not installed: running the script on fsm, fsmscope's SMACH-c
           "(with ROS-free rospy, smach_ros and actionlib)")
 
 
-def smach_installed() -> bool:
-    """Whether ``import smach`` would find a module (nothing is imported to tell)."""
+def smach_origin() -> str | None:
+    """Where ``import smach`` would find a module, None if nowhere (nothing is imported to tell)."""
     try:
-        return importlib.util.find_spec("smach") is not None
+        spec = importlib.util.find_spec("smach")
     except (ImportError, ValueError):  # a smach in sys.modules without a spec is there all the same
-        return True
+        return "an imported module"
+    return None if spec is None else str(spec.origin or (list(spec.submodule_search_locations or []) or ["?"])[0])
 
 
 class ScriptImports(importlib.abc.MetaPathFinder):
@@ -51,11 +53,12 @@ class ScriptImports(importlib.abc.MetaPathFinder):
         self._missing = _Missing()
 
     def install(self) -> None:
-        self.on_fsm = not smach_installed()
+        original = smach_origin()
+        self.on_fsm = original is None
+        self._missing.original = original
         sys.meta_path.insert(0, self)
-        if self.on_fsm:
-            sys.meta_path.append(self._missing)
-        elif isinstance(sys.modules.get("smach"), ModuleType):  # imported before the run: watched from now on
+        sys.meta_path.append(self._missing)
+        if not self.on_fsm and isinstance(sys.modules.get("smach"), ModuleType):  # imported before the run: watched from now on
             self._on_original(sys.modules["smach"])
 
     def uninstall(self) -> None:
@@ -126,11 +129,13 @@ class _Original(importlib.abc.Loader):
 
 
 class _Missing(importlib.abc.MetaPathFinder):
-    """Last on ``sys.meta_path``: a ROS module that nothing found, or a part of a counterpart it lacks."""
+    """Last on ``sys.meta_path``: a ROS module that nothing found (or a part a counterpart lacks)."""
+
+    original: str | None = None  # where the original smach is, if it is
 
     def find_spec(self, fullname: str, path: Sequence[str] | None = None,
                   target: ModuleType | None = None) -> None:
         top = fullname.partition(".")[0]
         if top in COVERED or is_ros_package(top):
-            raise missing_module(fullname)
+            raise missing_module(fullname, self.original)
         return None

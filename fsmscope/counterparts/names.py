@@ -31,12 +31,16 @@ def is_ros_package(top: str) -> bool:
     return top in ROS_PACKAGES or top.endswith(("_msgs", "_srvs", "_actions"))
 
 
-def missing_module(name: str) -> ModuleNotFoundError:
-    """The error for a ROS module ``name`` that is neither installed nor covered."""
-    return ModuleNotFoundError(
-        "No module named %r: smach is not installed, so fsmscope runs this script on fsm without ROS, and "
-        "has no ROS-free counterpart of %r (it has %s; %s)" % (name, name, ", ".join(sorted(COVERED)), GUIDE),
-        name=name)
+def missing_module(name: str, original: str | None) -> ModuleNotFoundError:
+    """The error for a ROS module ``name`` that is not installed: on fsm (``original`` None), one
+    that has no counterpart; beside the original smach (at ``original``), any."""
+    if original is None:
+        why = ("smach is not installed, so fsmscope runs this script on fsm without ROS, and has no ROS-free "
+               "counterpart of %r (it has %s; %s)" % (name, ", ".join(sorted(COVERED)), GUIDE))
+    else:
+        why = ("smach is installed (%s), so fsmscope runs this script on it as it is, with what is installed "
+               "beside it, and %r is not (%s)" % (original, name, GUIDE))
+    return ModuleNotFoundError("No module named %r: %s" % (name, why), name=name)
 
 
 def not_covered(module: str, attribute: str, covered: Iterable[str]) -> AttributeError:

@@ -1,0 +1,150 @@
+"""``fsmscope run`` on unchanged SMACH scripts, in real processes: the two ROS 1 tutorials run on fsm
+with ROS-free rospy and smach_ros where smach is not installed (saying so in one line), the original
+smach's machines are recorded where it is installed, and an import that cannot be served says why."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from fsm.logfiles.log_reader import read_events
+
+from recording_support import EXAMPLES, ROOT, cli
+
+NOTICE = "fsmscope: smach is not installed: running the script on fsm, fsmscope's SMACH-compatible runtime"
+ORIGINAL_SRC = Path(ROOT).parent / "shared/reference/executive_smach/noetic/smach/src"
+
+
+def run_script(script, log, pythonpath=None):
+    """``fsmscope run --exit --no-serve --record LOG SCRIPT``, with ``pythonpath`` before the project's."""
+    env = {"PYTHONPATH": str(pythonpath)} if pythonpath is not None else {}
+    return cli("run", "--exit", "--no-serve", "--record", log, script, env=env)
+
+
+def write_script(tmp_path, text, name="task.py"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def test_the_foo_bar_tutorial_runs_on_fsm_without_ros_and_records_its_machine(tmp_path):
+    log = tmp_path / "run.jsonl"
+    done = run_script(os.path.join(EXAMPLES, "tutorial_foo_bar.py"), log)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count(NOTICE) == 1
+    events = list(read_events(log))
+    assert {e["machine"] for e in events} == {"tutorial_foo_bar"}
+    assert [e["to"] for e in events if e["kind"] == "transition"] == ["BAR", "FOO"] * 3
+    assert [e["outcome"] for e in events if e["kind"] == "terminate"] == ["outcome4"]
+    assert [e["msg"] for e in events if e["kind"] == "log"][:2] == ["Executing state FOO", "Executing state BAR"]
+
+
+def test_the_service_action_tutorial_calls_its_service_and_action_on_fsm(tmp_path):
+    log = tmp_path / "run.jsonl"
+    done = run_script(os.path.join(EXAMPLES, "tutorial_service_action.py"), log)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.count(NOTICE) == 1
+    assert "The state machine ended in succeeded with sum=5" in done.stdout
+    events = list(read_events(log))
+    assert [(e["from"], e["outcome"], e["to"]) for e in events if e["kind"] == "transition"] == \
+        [("STATE1", "succeeded", "STATE2")]
+    assert "enable service called with data=True" in [e["msg"] for e in events if e["kind"] == "log"]
+    assert [e["changes"] for e in events if e["kind"] == "userdata"] == [{"sum": 5}]
+    assert [e["outcome"] for e in events if e["kind"] == "terminate"] == ["succeeded"]
+
+
+def test_a_ros_import_without_a_counterpart_fails_naming_the_module(tmp_path):
+    script = write_script(tmp_path, "import rospy\nimport smach\nfrom geometry_msgs.msg import Pose\n")
+    done = run_script(script, tmp_path / "run.jsonl")
+    assert done.returncode == 1
+    assert ("ModuleNotFoundError: No module named 'geometry_msgs': smach is not installed, so fsmscope runs "
+            "this script on fsm without ROS, and has no ROS-free counterpart of 'geometry_msgs'") in done.stderr
+
+
+def test_a_part_of_rospy_without_a_counterpart_says_so(tmp_path):
+    script = write_script(tmp_path, "import rospy\nrospy.get_param('~rate', 10)\n")
+    done = run_script(script, tmp_path / "run.jsonl")
+    assert done.returncode == 1
+    assert ("AttributeError: rospy.get_param: fsmscope runs this script without ROS, and its ROS-free rospy "
+            "has no get_param") in done.stderr
+
+
+def test_smach_is_not_importable_outside_fsmscope_run():
+    done = subprocess.run([sys.executable, "-c", "import fsmscope.server.runner, smach"], cwd=ROOT,
+                          env=dict(os.environ, PYTHONPATH=ROOT), capture_output=True, text=True, timeout=60)
+    assert done.returncode == 1
+    assert done.stderr.strip().endswith("ModuleNotFoundError: No module named 'smach'")
+
+
+@pytest.mark.parametrize("init, reason", [
+    ("import smach_yaml_dependency\n", "ModuleNotFoundError: No module named 'smach_yaml_dependency'"),
+    ("def broken(:\n    pass\n", "SyntaxError: invalid syntax (__init__.py, line 1)"),
+], ids=["missing-dependency", "syntax-error"])
+def test_a_broken_smach_says_its_own_reason_and_not_the_fallback(tmp_path, init, reason):
+    site = tmp_path / "site"
+    (site / "smach").mkdir(parents=True)
+    (site / "smach" / "__init__.py").write_text(init)
+    script = write_script(tmp_path, "import smach\n")
+    done = run_script(script, tmp_path / "run.jsonl", pythonpath=site)
+    assert done.returncode == 1
+    assert ("fsmscope run: smach is installed (%s) but cannot be imported: %s"
+            % (site / "smach" / "__init__.py", reason)) in done.stderr
+    assert NOTICE not in done.stderr
+
+
+needs_original = pytest.mark.skipif(not ORIGINAL_SRC.is_dir(), reason="the original SMACH core is not at %s "
+                                    "(a copy of shared/ beside the project root)" % ORIGINAL_SRC)
+
+FOO_BAR_ON_SMACH = """\
+import smach
+
+
+class Foo(smach.State):
+    def __init__(self):
+        smach.State.__init__(self, outcomes=['outcome1', 'outcome2'])
+        self.counter = 0
+
+    def execute(self, userdata):
+        smach.loginfo('Executing state FOO')
+        if self.counter < 3:
+            self.counter += 1
+            return 'outcome1'
+        return 'outcome2'
+
+
+class Bar(smach.State):
+    def __init__(self):
+        smach.State.__init__(self, outcomes=['outcome2'])
+
+    def execute(self, userdata):
+        return 'outcome2'
+
+
+sm = smach.StateMachine(outcomes=['outcome4'])
+with sm:
+    smach.StateMachine.add('FOO', Foo(), transitions={'outcome1': 'BAR', 'outcome2': 'outcome4'})
+    smach.StateMachine.add('BAR', Bar(), transitions={'outcome2': 'FOO'})
+print('ran on', smach.__file__, 'to', sm.execute())
+"""
+
+
+@needs_original
+def test_a_machine_of_the_original_smach_is_recorded(tmp_path):
+    log = tmp_path / "run.jsonl"
+    done = run_script(write_script(tmp_path, FOO_BAR_ON_SMACH), log, pythonpath=ORIGINAL_SRC)
+    assert done.returncode == 0, done.stderr
+    assert "ran on %s to outcome4" % (ORIGINAL_SRC / "smach" / "__init__.py") in done.stdout
+    assert NOTICE not in done.stderr
+    events = list(read_events(log))
+    assert {e["machine"] for e in events} == {"task"}
+    assert [e["to"] for e in events if e["kind"] == "transition"] == ["BAR", "FOO"] * 3
+    assert [e["outcome"] for e in events if e["kind"] == "terminate"] == ["outcome4"]
+
+
+@needs_original
+def test_beside_the_original_smach_a_missing_rospy_is_said_to_be_needed(tmp_path):
+    done = run_script(os.path.join(EXAMPLES, "tutorial_foo_bar.py"), tmp_path / "run.jsonl", pythonpath=ORIGINAL_SRC)
+    assert done.returncode == 1
+    assert ("No module named 'rospy': smach is installed (%s), so fsmscope runs this script on it as it is"
+            % (ORIGINAL_SRC / "smach" / "__init__.py")) in done.stderr

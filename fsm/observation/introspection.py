@@ -173,13 +173,17 @@ class Reporter:
         return _describe(self.root, label, self.root_path, self, {})
 
 
+_OWN_PACKAGES = ("fsm", "smach", "smach_ros")  # whose classes' docstrings are SMACH's, not the task's
+
+
 @functools.lru_cache(maxsize=1024)
 def class_doc(cls: type) -> str | None:
     """The first paragraph of a class's own docstring, on one line, at most MAX_DOC characters: what a
-    user's state does, for the page's details. None for fsm's own classes (the same text in every
-    node would say nothing of the task) and a class without one (a docstring is never inherited)."""
+    user's state does, for the page's details. None for fsm's own classes and the original SMACH's
+    (the same text in every node would say nothing of the task) and a class without one (a
+    docstring is never inherited)."""
     doc = cls.__dict__.get("__doc__")
-    if not isinstance(doc, str) or cls.__module__.split(".")[0] == "fsm":
+    if not isinstance(doc, str) or cls.__module__.split(".")[0] in _OWN_PACKAGES:
         return None
     first = " ".join(inspect.cleandoc(doc).split("\n\n")[0].split())
     if not first:
@@ -213,16 +217,21 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
 
 def attach(machine: Any, observer: Observer | None = None, name: str | None = None,
            path: str = DEFAULT_ROOT_PATH) -> Reporter:
-    """Observe a top-level container; a second call adds an observer to the same reporter. ``name``
-    must keep the name rule (fsm/observation/names.py: ValueError saying why); without one the
-    machine is named after its root path."""
+    """Observe a top-level container, of fsm or of the original SMACH (fsm/observation/original.py);
+    a second call adds an observer to the same reporter. ``name`` must keep the name rule
+    (fsm/observation/names.py: ValueError saying why); without one the machine is named after its
+    root path."""
     rep = getattr(machine, "_reporter", None)
     if rep is None or rep.root is not machine:
         name = names.check(name) if name else names.valid(path.rsplit("/", 1)[-1] or "SM_ROOT")
-        rep = Reporter(machine, name, path)
-        machine._reporter = rep
-        machine._path = path
-        rep.structure()
+        from . import original  # here: it builds on this module
+        if original.is_original(machine):
+            rep = original.attach(machine, name, path)
+        else:
+            rep = Reporter(machine, name, path)
+            machine._reporter = rep
+            machine._path = path
+            rep.structure()
     if observer is not None:
         rep.add_observer(observer)
     return rep

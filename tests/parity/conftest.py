@@ -23,15 +23,27 @@ import pytest
 pytest.register_assert_rewrite("parity_support")
 from parity_support import Parity  # noqa: E402
 
-ORIGINAL_SRC = Path(__file__).resolve().parents[2].parent / "shared/reference/executive_smach/noetic/smach/src"
+REFERENCE = Path(__file__).resolve().parents[2].parent / "shared/reference/executive_smach"
+ORIGINAL_SRC = REFERENCE / "noetic/smach/src"
+CORES = {"noetic": ORIGINAL_SRC, "ros2": REFERENCE / "ros2/smach"}  # where each branch's ``smach`` package is
 
 
 @pytest.fixture(scope="module")
 def original():
-    """The original ``smach`` package, loaded from its source for this module's tests."""
-    init = ORIGINAL_SRC / "smach" / "__init__.py"
+    """The original ``smach`` package (noetic-devel), loaded from its source for this module's tests."""
+    yield from _loaded(ORIGINAL_SRC)
+
+
+@pytest.fixture(scope="module", params=sorted(CORES))
+def either_core(request):
+    """The original ``smach`` package of each branch in turn (noetic-devel, then ros2), for this module's tests."""
+    yield from _loaded(CORES[request.param])
+
+
+def _loaded(src: Path):
+    init = src / "smach" / "__init__.py"
     if not init.exists():
-        pytest.skip("the original SMACH core is not at %s (a copy of shared/ beside the project root)" % ORIGINAL_SRC)
+        pytest.skip("the original SMACH core is not at %s (a copy of shared/ beside the project root)" % src)
     before = {name: module for name, module in sys.modules.items() if name == "smach" or name.startswith("smach.")}
     for name in before:
         del sys.modules[name]
@@ -45,6 +57,17 @@ def original():
         for name in [n for n in sys.modules if n == "smach" or n.startswith("smach.")]:
             del sys.modules[name]
         sys.modules.update(before)
+
+
+@pytest.fixture
+def core(either_core):
+    """``either_core`` with its log functions and shutdown check put back after the test (watching a
+    machine wraps them)."""
+    saved = {name: getattr(either_core, name) for name in ("loginfo", "logwarn", "logdebug", "logerr", "is_shutdown")}
+    yield either_core
+    for name, value in saved.items():
+        setattr(either_core, name, value)
+    either_core.Container._construction_stack.clear()
 
 
 @pytest.fixture

@@ -1,0 +1,318 @@
+"""One container of a machine of the original SMACH, watched: its callbacks and its children's calls
+made into the events an fsm container reports (docs/events.md).
+
+The original tells a container's start, transitions and termination through the callbacks it offers
+(``register_start_cb``, ``register_transition_cb``, ``register_termination_cb``, as smach_ros's
+IntrospectionServer uses them); not which outcome caused a transition, what a child raised, nor
+when a preempt was serviced. Those only the calls themselves tell: ``Watched`` stands for a state's
+``execute`` (an attribute of the instance, calling the method it replaces with the same arguments
+and returning what it returns), ``PreemptWatched`` for its ``request_preempt`` or
+``service_preempt``. Nothing here changes what the machine does: every hook calls through, returns
+the same value or lets the same exception out, and what goes wrong in observing is said once on
+stderr (``Reporter._failed``).
+
+The debugger's gates (fsm/debugging/debugger.py) are called as fsm's containers call them: before
+and after a child's ``execute``, when the container has a ``_debugger``.
+
+One piece because a container's callbacks and its children's wrapped calls share one record of the
+run (the last outcome, the failure, the outcomes of a Concurrence's children).
+"""
+
+from __future__ import annotations
+
+import threading
+import traceback
+from typing import Any
+
+from ..core import reporting
+from .introspection import _words
+from .original_userdata import UserdataWatch
+from .schema import ABSENT, build
+
+
+def is_concurrence(container: Any) -> bool:
+    """The original's Concurrence (or a subclass): its children run at once, on threads of their own."""
+    return hasattr(container, "_child_outcomes") and hasattr(container, "_outcome_map")
+
+
+def _labels(states: Any) -> list[str]:
+    """A callback's states as a list of strings (the original's Iterator gives one label, not a list)."""
+    if states is None:
+        return []
+    if isinstance(states, str):
+        return [states]
+    return [str(s) for s in states]
+
+
+class ContainerWatch:
+    """The events of one container: made from its callbacks and its children's wrapped calls."""
+
+    def __init__(self, container: Any) -> None:
+        self.container = container
+        self.rep: Any = None  # the reporter and path it reports for (set by each description)
+        self.path = ""
+        self.is_root = False
+        self.concurrent = is_concurrence(container)
+        self.userdata = UserdataWatch()
+        self._lock = threading.RLock()  # a Concurrence's children call in from their threads
+        self.active: list[str] = []
+        self.entered = False  # its execute (wrapped) is running: set on entry, before its start
+        self.started = False  # its start callback came in this run
+        self.ended = False  # its terminate event was sent in this run
+        self.last: tuple[str, str] | None = None  # the (label, outcome) a child returned last
+        self.failure: tuple[str, BaseException] | None = None  # the first child that raised in this run
+        self.finished: list[str] = []  # a Concurrence's children in the order they returned
+        self.outcomes: dict[str, str | None] = {}  # a Concurrence's children's outcomes, reported
+        container.register_start_cb(self._on_start)
+        container.register_transition_cb(self._on_transition)
+        container.register_termination_cb(self._on_termination)
+
+    def bind(self, rep: Any, path: str, is_root: bool) -> None:
+        self.rep, self.path, self.is_root = rep, path, is_root
+
+    def _listening(self) -> Any:
+        """The reporter, when it still reports this container and somebody observes it; else None."""
+        rep = self.rep
+        if rep is None or not rep._observers or getattr(self.container, "_reporter", None) is not rep:
+            return None
+        return rep
+
+    # The container's callbacks (called by the original, with its locks held; never raising).
+    def _on_start(self, userdata: Any, initial_states: Any, *args: Any) -> None:
+        try:
+            with self._lock:
+                if self.is_root and self.rep is not None:
+                    self.rep.root_started()
+                self.started, self.ended, self.last, self.failure = True, False, None, None
+                self.finished, self.outcomes = [], {}
+                initial = _labels(initial_states)
+                self.active = list(initial) if self.concurrent else _labels(self.container.get_active_states())
+                rep = self._listening()
+                if rep is None:
+                    self.userdata.forget()
+                    return
+                rep.send(build.start, self.path, initial, list(self.active), self.userdata.snapshot(userdata))
+        except Exception:
+            self._failed("start")
+
+    def _on_transition(self, userdata: Any, active_states: Any, *args: Any) -> None:
+        try:
+            with self._lock:
+                rep = self._listening()
+                if rep is not None:
+                    self._report_changes(rep, userdata)
+                if self.concurrent:
+                    self._children_returned(rep)
+                    return
+                active = _labels(active_states)
+                last, self.last = self.last, None
+                to = active[0] if active else None
+                if last is None:  # the child ran before this machine was watched
+                    last = (self.active[0] if self.active else "None", self._outcome_to(to))
+                self.active = active
+                if rep is not None:
+                    rep.transition(self.path, last[0], last[1], to, active)
+        except Exception:
+            self._failed("transition")
+
+    def _on_termination(self, userdata: Any, terminal_states: Any, outcome: Any, *args: Any) -> None:
+        try:
+            with self._lock:
+                rep = self._listening()
+                last = _labels(terminal_states)
+                self.active, self.ended = [], True
+                if rep is None:
+                    return
+                self._report_changes(rep, userdata)
+                outcome = None if outcome is None else str(outcome)
+                if self.concurrent:
+                    rep.terminate(self.path, last, outcome, [],
+                                  outcomes={label: self.outcomes.get(label) for label in self._children()})
+                    return
+                returned = self.last
+                state_outcome = ABSENT if not self.started else (returned[1] if returned is not None else None)
+                rep.terminate(self.path, last, outcome, [], state_outcome=state_outcome)
+        except Exception:
+            self._failed("termination")
+
+    # What the children's wrapped calls tell.
+    def returned(self, label: str, outcome: Any) -> None:
+        """A child returned ``outcome`` (before its container takes the transition)."""
+        with self._lock:
+            if self.concurrent:
+                self.finished.append(label)
+            else:
+                self.last = (label, None if outcome is None else str(outcome))
+
+    def child_failed(self, label: str, exc: BaseException) -> None:
+        with self._lock:
+            if self.failure is None:
+                self.failure = (label, exc)
+
+    def entering(self) -> None:
+        """Its own ``execute`` begins (before its start callback, if it gets that far)."""
+        self.entered, self.started, self.ended = True, False, False
+
+    def left(self, exc: BaseException | None) -> None:
+        """Its own ``execute`` ended: raising ``exc``, or without a terminate (no outcome)."""
+        self.entered = False
+        if self.ended:
+            return
+        self.ended = True
+        try:
+            rep = self._listening()
+            if rep is None:
+                return
+            if exc is None:  # a consistency check that failed, or a shutdown
+                rep.terminate(self.path, [], None, [],
+                              error="shutdown" if self.started else "consistency check failed")
+                return
+            label, cause = self.failure if self.failure is not None else (self._current_label(), None)
+            self._report_error(rep, label, exc, cause)
+            rep.terminate(self.path, [] if label is None else [label], None, [],
+                          error="%s: %s" % (type(exc).__name__, _words(exc)))
+        except Exception:
+            self._failed("error")
+
+    def report_changes(self) -> None:
+        """A ``userdata`` event of the keys changed since the last (the debugger's hold shows them)."""
+        try:
+            with self._lock:
+                rep = self._listening()
+                if rep is not None:
+                    self._report_changes(rep, self.container.userdata)
+        except Exception:
+            self._failed("userdata")
+
+    # Inside.
+    def _report_changes(self, rep: Any, userdata: Any) -> None:
+        changes = self.userdata.changes(userdata)
+        if changes:
+            rep.send(build.userdata, self.path, changes)
+
+    def _children(self) -> list[str]:
+        return [str(label) for label in self.container.get_children()]
+
+    def _children_returned(self, rep: Any) -> None:
+        """A Concurrence's transition callback (at a child's start and after it returned): a
+        ``transition`` for each child whose outcome it has taken since, in the order they returned."""
+        taken = {str(k): v for k, v in dict(self.container._child_outcomes).items()}
+        new = [label for label in self.finished if label not in self.outcomes and taken.get(label) is not None]
+        new += [label for label, o in taken.items() if o is not None and label not in self.outcomes and label not in new]
+        for i, label in enumerate(new):
+            self.outcomes[label] = str(taken[label])
+            later = set(new[i + 1:])
+            active = [lbl for lbl, o in taken.items() if o is None or lbl in later]
+            self.active = active
+            if rep is not None:
+                rep.transition(self.path, label, self.outcomes[label], None, active)
+
+    def _outcome_to(self, to: str | None) -> str:
+        """The outcome of the previous active state that leads to ``to`` (its container's edges), for
+        a child that returned before the machine was watched; '?' when its edges do not say."""
+        if self.active:
+            leading = [str(o) for o, frm, target in self.container.get_internal_edges()
+                       if str(frm) == self.active[0] and str(target) == to]
+            if len(leading) == 1:
+                return leading[0]
+        return "?"
+
+    def _current_label(self) -> str | None:
+        label = getattr(self.container, "_current_label", None)
+        return None if label is None else str(label)
+
+    def _report_error(self, rep: Any, label: str | None, exc: BaseException, cause: BaseException | None) -> None:
+        """An ``error`` event, once per exception, from the innermost container that saw it: the root
+        cause is the child's exception (the original wraps it without chaining it as a cause)."""
+        if cause is not None:
+            first = reporting.mark_reported(cause)
+            reporting.mark_reported(exc)
+            if not first:
+                return
+            root = cause
+        else:
+            if not reporting.mark_reported(exc):
+                return
+            root = exc
+        while root.__cause__ is not None:
+            root = root.__cause__
+        chain = traceback.format_exception(type(exc), exc, exc.__traceback__)
+        if cause is not None and cause is not exc.__context__ and cause is not exc.__cause__:
+            chain = traceback.format_exception(type(cause), cause, cause.__traceback__) + chain
+        rep.send(build.error, self.path, label, type(root).__name__, _words(root), "".join(chain),
+                 type(exc).__name__ if root is not exc else ABSENT)
+
+    def _failed(self, what: str) -> None:
+        rep = self.rep
+        if rep is not None:
+            rep._failed(self, "observing (%s of %s)" % (what, self.path))
+
+
+class Watched:
+    """A state's ``execute`` as its container (or the user, for the root) calls it: the same call, with
+    the thread's observed container set (for its log lines), the debugger's gates, and what the call
+    told (the outcome returned, the exception raised) handed to the container's watch."""
+
+    def __init__(self, state: Any, inner: Any) -> None:
+        self.state = state
+        self.inner = inner  # the bound method it stands for
+        self.parent: ContainerWatch | None = None  # its container's watch (None: the root)
+        self.label = ""
+        self.own: ContainerWatch | None = None  # its own watch, when it is a container
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        parent, own, label = self.parent, self.own, self.label
+        watch = own if own is not None else parent
+        rep = watch.rep if watch is not None else None
+        prev = reporting.enter(rep, watch.path) if rep is not None else reporting.NOT_ENTERED
+        try:
+            if own is not None:
+                if parent is None and rep is not None:
+                    rep.root_entered()
+                own.entering()
+            container = parent.container if parent is not None else None
+            dbg = getattr(container, "_debugger", None)
+            outcome = dbg.before(container, label, self.state) if dbg is not None else None
+            if outcome is None:
+                try:
+                    outcome = self.inner(*args, **kwargs)
+                except BaseException as exc:
+                    if own is not None:
+                        own.left(exc)
+                    if parent is not None:
+                        parent.child_failed(label, exc)
+                    raise
+            dbg = getattr(container, "_debugger", None)
+            if dbg is not None and outcome is not None:
+                outcome = dbg.after(container, label, self.state, outcome)
+            if own is not None:
+                own.left(None)
+            if parent is not None:
+                parent.returned(label, outcome)
+            return outcome
+        finally:
+            if own is not None and parent is None and rep is not None:
+                rep.root_left()
+            reporting.leave(prev)
+
+
+class PreemptWatched:
+    """A state's ``request_preempt`` (``phase`` 'requested', a container's) or ``service_preempt``
+    ('serviced', any state's): the same call, and a ``preempt`` event of the state's path."""
+
+    def __init__(self, state: Any, inner: Any, phase: str) -> None:
+        self.state, self.inner, self.phase = state, inner, phase
+
+    def __call__(self, *args: Any, **kwargs: Any) -> Any:
+        if self.phase == "serviced":
+            result = self.inner(*args, **kwargs)
+            self._report()
+            return result
+        self._report()
+        return self.inner(*args, **kwargs)
+
+    def _report(self) -> None:
+        state = self.state
+        rep = getattr(state, "_reporter", None)
+        if rep is not None and rep._observers:
+            rep.preempt(getattr(state, "_path", rep.root_path), self.phase)

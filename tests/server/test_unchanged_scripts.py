@@ -142,6 +142,44 @@ def test_a_machine_of_the_original_smach_is_recorded(tmp_path):
     assert [e["outcome"] for e in events if e["kind"] == "terminate"] == ["outcome4"]
 
 
+NESTED_ON_SMACH = """\
+import smach
+
+
+def leaf(outcome):
+    return smach.CBState(lambda ud: outcome, outcomes=[outcome])
+
+
+def build():
+    inner = smach.StateMachine(outcomes=['done'])
+    with inner:
+        smach.StateMachine.add('LEAF', leaf('done'), transitions={'done': 'done'})
+    both = smach.Concurrence(outcomes=['done'], default_outcome='done', outcome_map={'done': {'INNER': 'done'}})
+    with both:
+        smach.Concurrence.add('INNER', inner)
+        smach.Concurrence.add('OTHER', leaf('done'))
+    top = smach.StateMachine(outcomes=['end'])
+    with top:
+        smach.StateMachine.add('BOTH', both, transitions={'done': 'AGAIN'})
+        smach.StateMachine.add('AGAIN', leaf('again'), transitions={'again': 'end'})
+    return top
+
+
+build().execute()
+build().execute()
+"""
+
+
+@needs_original
+def test_each_top_level_machine_of_the_original_smach_is_recorded_with_its_nested_ones_inside(tmp_path):
+    log = tmp_path / "run.jsonl"
+    done = run_script(write_script(tmp_path, NESTED_ON_SMACH), log, pythonpath=ORIGINAL_SRC)
+    assert done.returncode == 0, done.stderr
+    ends = [(e["machine"], e["path"], e["outcome"]) for e in read_events(log) if e["kind"] == "terminate"]
+    assert ends == [(machine, path, outcome) for machine in ("task", "task-2") for path, outcome in
+                    (("/SM_ROOT/BOTH/INNER", "done"), ("/SM_ROOT/BOTH", "done"), ("/SM_ROOT", "end"))]
+
+
 @needs_original
 def test_beside_the_original_smach_a_missing_rospy_is_said_to_be_needed(tmp_path):
     done = run_script(os.path.join(EXAMPLES, "tutorial_foo_bar.py"), tmp_path / "run.jsonl", pythonpath=ORIGINAL_SRC)

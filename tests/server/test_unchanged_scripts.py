@@ -2,15 +2,21 @@
 with ROS-free rospy and smach_ros where smach is not installed (saying so in one line), the original
 smach's machines are recorded where it is installed, and an import that cannot be served says why."""
 
+import contextlib
+import json
 import os
+import re
+import signal
 import subprocess
 import sys
 from pathlib import Path
 
+import httpx
 import pytest
 from fsm.logfiles.log_reader import read_events
 
 from recording_support import EXAMPLES, ROOT, cli
+from fsmscope.server.testing.polling import wait_for
 
 NOTICE = "fsmscope: smach is not installed: running the script on fsm, fsmscope's SMACH-compatible runtime"
 ORIGINAL_SRC = Path(ROOT).parent / "shared/reference/executive_smach/noetic/smach/src"
@@ -52,6 +58,48 @@ def test_the_service_action_tutorial_calls_its_service_and_action_on_fsm(tmp_pat
     assert "enable service called with data=True" in [e["msg"] for e in events if e["kind"] == "log"]
     assert [e["changes"] for e in events if e["kind"] == "userdata"] == [{"sum": 5}]
     assert [e["outcome"] for e in events if e["kind"] == "terminate"] == ["succeeded"]
+
+
+@contextlib.contextmanager
+def served_run(script, log, pythonpath=None):
+    """``fsmscope run --record LOG SCRIPT`` serving its dashboard: yields an HTTP client of the
+    dashboard once the script has ended; Ctrl-C then ends it, which must exit 0."""
+    paths = ([str(pythonpath)] if pythonpath is not None else []) + [ROOT]
+    proc = subprocess.Popen([sys.executable, "-m", "fsmscope", "run", "--record", str(log), str(script)], cwd=ROOT,
+                            env=dict(os.environ, PYTHONPATH=os.pathsep.join(paths)), stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE, text=True)
+    try:
+        said = []
+        for line in proc.stderr:
+            said.append(line)
+            if "the script ended" in line:
+                break
+        address = re.search(r"dashboard at (http://[^/]+)/\?token=(\S+)", "".join(said))
+        assert address, said
+        base, token = address.groups()
+        with httpx.Client(base_url=base, headers={"Authorization": "Bearer " + token}, timeout=10) as http:
+            yield http
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(20) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def test_a_tutorials_machine_is_served_and_runs_again_from_the_dashboard_after_the_script_ended(tmp_path):
+    log = tmp_path / "run.jsonl"
+    with served_run(os.path.join(EXAMPLES, "tutorial_foo_bar.py"), log) as http:
+        status = http.get("/api/machines/tutorial_foo_bar/status").json()
+        assert (status["running"], status["outcome"]) == (False, "outcome4")
+        assert http.post("/api/machines/tutorial_foo_bar/start", json={}).status_code == 202
+
+        def the_new_run_ended():
+            now = http.get("/api/machines/tutorial_foo_bar/status").json()
+            return now["run"] != status["run"] and not now["running"] and now["outcome"] == "outcome4"
+        wait_for(the_new_run_ended, 10, interval=0.02, what="the run started from the dashboard to end")
+    summary = json.loads(cli("replay", log, "--json").stdout)
+    assert summary["machines"]["tutorial_foo_bar"]["runs"] == 2
 
 
 def test_a_ros_import_without_a_counterpart_fails_naming_the_module(tmp_path):
@@ -168,6 +216,14 @@ def build():
 build().execute()
 build().execute()
 """
+
+
+@needs_original
+def test_a_machine_of_the_original_smach_is_served_on_the_dashboard(tmp_path):
+    with served_run(write_script(tmp_path, FOO_BAR_ON_SMACH), tmp_path / "run.jsonl", ORIGINAL_SRC) as http:
+        assert [m["name"] for m in http.get("/api/machines").json()] == ["task"]
+        status = http.get("/api/machines/task/status").json()
+        assert (status["running"], status["outcome"]) == (False, "outcome4")
 
 
 @needs_original

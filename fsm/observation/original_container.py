@@ -55,7 +55,7 @@ class ContainerWatch:
         self.concurrent = is_concurrence(container)
         self.userdata = UserdataWatch()
         self._lock = threading.RLock()  # a Concurrence's children call in from their threads
-        self.active: list[str] = []
+        self.active = [s for s in _labels(container.get_active_states()) if s != "None"]  # running when watched?
         self.entered = False  # its execute (wrapped) is running: set on entry, before its start
         self.started = False  # its start callback came in this run
         self.ended = False  # its terminate event was sent in this run
@@ -293,7 +293,11 @@ class Watched:
         finally:
             if own is not None and parent is None and rep is not None:
                 rep.root_left()
-            reporting.leave(prev)
+            if prev is not None or parent is None or not parent.concurrent:
+                reporting.leave(prev)
+            # else: a thread the original's Concurrence started for this child, which ends once the
+            # child's outcome is taken: the lines it logs until then (SMACH's wrapping of the
+            # child's exception, its word of a missing outcome) stay the Concurrence's.
 
 
 class PreemptWatched:

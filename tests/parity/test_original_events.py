@@ -2,8 +2,12 @@
 sends are those of docs/events.md, made from its callbacks and its children's calls."""
 
 import fsm
+import pytest
 from fsm.observation import schema
 from fsm.observation.status import rebuild
+
+from original_support import SCENARIOS, run
+from parity_support import kit, normalised
 
 
 def foo_bar(smach):
@@ -66,3 +70,64 @@ def test_the_structure_of_an_original_machine_is_read_from_its_containers(core):
     assert sorted((t["from"], t["outcome"], t["to"]) for t in root["transitions"]) == [
         ("BAR", "outcome1", "FOO"), ("FOO", "outcome1", "BAR"), ("FOO", "outcome2", "outcome4")]
     assert root["children"][0]["input_keys"] == ["counter"]
+
+
+# The same machines on the original SMACH and on fsm, watched: the same events.
+
+def _by_path(events):
+    """Each path's events in order, normalised, without what only says when (seq, t, run): a
+    Concurrence's children run on threads of their own, so only the order of one path's events is set.
+
+    A log line's and an error's words are compared up to their first line: past it, the traceback
+    that SMACH writes into an InvalidUserCodeError is the runtime's own (its frames, and fsm chains
+    the child's exception as the cause of a failed Concurrence's, which the original does not)."""
+    paths = {}
+    for event in events:
+        if event["kind"] == "structure":
+            continue
+        fields = {k: v.split("\n")[0] if k in ("msg", "error") and isinstance(v, str) else v
+                  for k, v in event.items() if k not in ("v", "seq", "t", "run", "machine", "traceback")}
+        paths.setdefault(event["path"], []).append(normalised(fields))
+    for path, seen in paths.items():  # lines logged by two threads of one Concurrence: in any order
+        logs = sorted((e for e in seen if e["kind"] == "log"), key=repr)
+        paths[path] = [e for e in seen if e["kind"] != "log"] + logs
+    return paths
+
+
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
+def test_a_machine_of_the_original_sends_the_events_the_same_machine_sends_on_fsm(original, scenario, tmp_path):
+    theirs = run(original, SCENARIOS[scenario], tmp_path / "original.jsonl")["events"]
+    ours = run(fsm, SCENARIOS[scenario], tmp_path / "fsm.jsonl")["events"]
+    assert _by_path(theirs) == _by_path(ours)
+    assert normalised(theirs[0]["root"]) == normalised(ours[0]["root"])
+
+
+def test_where_userdata_events_differ_from_fsms_a_change_is_a_value_that_differs_not_a_write(original, tmp_path):
+    """fsm tracks the keys a state writes; the original's UserData keeps no such record, so a change is
+    a value that differs from the last reported one (original_userdata.py). A list appended to in
+    place is a change on the original (fsm shows it at the container's next start), and a key written
+    with the value it held is none (fsm reports the write)."""
+
+    def scenario(side):
+        k = kit(side.sm)
+
+        def append(ud):
+            ud.items.append(1)
+            return "done"
+
+        def same(ud):
+            ud.n = 5
+            return "done"
+
+        built = k.machine(["done"], [
+            ("APPEND", k.Out(append, io_keys=["items"]), {"done": "SAME"}),
+            ("SAME", k.Out(same, output_keys=["n"]), {})])
+        built.userdata.items, built.userdata.n = [], 5
+        return built
+
+    def changes(sm, log):
+        events = run(sm, scenario, tmp_path / log)["events"]
+        return [(e["kind"], e.get("from"), e.get("changes")) for e in events if e["kind"] in ("userdata", "transition")]
+
+    assert changes(original, "original.jsonl") == [("userdata", None, {"items": [1]}), ("transition", "APPEND", None)]
+    assert changes(fsm, "fsm.jsonl") == [("transition", "APPEND", None), ("userdata", None, {"n": 5})]

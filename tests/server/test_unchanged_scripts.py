@@ -19,7 +19,9 @@ from recording_support import EXAMPLES, ROOT, cli
 from fsmscope.server.testing.polling import wait_for
 
 NOTICE = "fsmscope: smach is not installed: running the script on fsm, fsmscope's SMACH-compatible runtime"
-ORIGINAL_SRC = Path(ROOT).parent / "shared/reference/executive_smach/noetic/smach/src"
+REFERENCE = Path(ROOT).parent / "shared/reference/executive_smach"
+ORIGINAL_SRC = REFERENCE / "noetic/smach/src"
+CORES = {"noetic": ORIGINAL_SRC, "ros2": REFERENCE / "ros2/smach"}  # where each branch's smach package is
 
 
 def run_script(script, log, pythonpath=None):
@@ -178,11 +180,12 @@ print('ran on', smach.__file__, 'to', sm.execute())
 
 
 @needs_original
-def test_a_machine_of_the_original_smach_is_recorded(tmp_path):
+@pytest.mark.parametrize("branch", sorted(CORES))
+def test_a_machine_of_the_original_smach_is_recorded(tmp_path, branch):
     log = tmp_path / "run.jsonl"
-    done = run_script(write_script(tmp_path, FOO_BAR_ON_SMACH), log, pythonpath=ORIGINAL_SRC)
+    done = run_script(write_script(tmp_path, FOO_BAR_ON_SMACH), log, pythonpath=CORES[branch])
     assert done.returncode == 0, done.stderr
-    assert "ran on %s to outcome4" % (ORIGINAL_SRC / "smach" / "__init__.py") in done.stdout
+    assert "ran on %s to outcome4" % (CORES[branch] / "smach" / "__init__.py") in done.stdout
     assert NOTICE not in done.stderr
     events = list(read_events(log))
     assert {e["machine"] for e in events} == {"task"}
@@ -227,9 +230,10 @@ def test_a_machine_of_the_original_smach_is_served_on_the_dashboard(tmp_path):
 
 
 @needs_original
-def test_each_top_level_machine_of_the_original_smach_is_recorded_with_its_nested_ones_inside(tmp_path):
+@pytest.mark.parametrize("branch", sorted(CORES))
+def test_each_top_level_machine_of_the_original_smach_is_recorded_with_its_nested_ones_inside(tmp_path, branch):
     log = tmp_path / "run.jsonl"
-    done = run_script(write_script(tmp_path, NESTED_ON_SMACH), log, pythonpath=ORIGINAL_SRC)
+    done = run_script(write_script(tmp_path, NESTED_ON_SMACH), log, pythonpath=CORES[branch])
     assert done.returncode == 0, done.stderr
     ends = [(e["machine"], e["path"], e["outcome"]) for e in read_events(log) if e["kind"] == "terminate"]
     assert ends == [(machine, path, outcome) for machine in ("task", "task-2") for path, outcome in

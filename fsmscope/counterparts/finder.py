@@ -58,7 +58,7 @@ class ScriptImports(importlib.abc.MetaPathFinder):
         self._missing.original = original
         sys.meta_path.insert(0, self)
         sys.meta_path.append(self._missing)
-        if not self.on_fsm and isinstance(sys.modules.get("smach"), ModuleType):  # imported before the run: watched from now on
+        if not self.on_fsm and isinstance(sys.modules.get("smach"), ModuleType):  # imported before the run
             self._on_original(sys.modules["smach"])
 
     def uninstall(self) -> None:

@@ -62,6 +62,12 @@ def test_the_service_action_tutorial_calls_its_service_and_action_on_fsm(tmp_pat
     assert [e["outcome"] for e in events if e["kind"] == "terminate"] == ["succeeded"]
 
 
+def test_a_script_on_fsm_itself_gets_no_notice(tmp_path):
+    done = run_script(os.path.join(EXAMPLES, "foo_bar.py"), tmp_path / "run.jsonl")
+    assert done.returncode == 0, done.stderr
+    assert "smach is not installed" not in done.stderr
+
+
 @contextlib.contextmanager
 def served_run(script, log, pythonpath=None):
     """``fsmscope run --record LOG SCRIPT`` serving its dashboard: yields an HTTP client of the

@@ -131,7 +131,7 @@ def loop_once(case: str, transitions: int, endpoint: str) -> None:
     "followed": a watcher listening at ``endpoint`` follows it): what callgrind counts (the warm-up's
     instructions, and the watcher's join, are in the runs of ``transitions`` and of none alike)."""
     runtime.LOOP_TRANSITIONS = transitions
-    fleet.robot.LINGER = 1.0  # callgrind slows the loop: batches as full as at full speed (MAX_BATCH)
+    fsmscope.fleet.robot.LINGER = 1.0  # callgrind slows the loop: batches as full as at full speed (MAX_BATCH)
     fsm.set_loggers(*[lambda msg: None] * 4)
     srv = ServerThread().start()
     make = {"base": None, "quiet": lambda: ZenohRobot("bench", token="bench"),

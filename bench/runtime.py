@@ -10,6 +10,7 @@ import statistics
 import sys
 import tempfile
 import time
+from typing import Any
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
 
@@ -21,24 +22,33 @@ NESTED_STEPS = 100_000
 CONCURRENCE_RUNS = 10_000
 
 
-class Flip(smach.State):
-    """Returns 'next' until its budget is spent, then 'done' (and re-arms when told to)."""
+def flip_class(smach: Any = smach, counts: bool = False) -> type:
+    """A state of ``smach`` (fsm, or the original SMACH for bench/original_smach.py) that returns
+    'next' until its budget is spent, then 'done' (and re-arms when told to); with ``counts``, it
+    also adds one to the userdata's ``count`` at each run, as a task's states write what they did."""
 
-    def __init__(self, budget: list, rearm: int = 0) -> None:
-        smach.State.__init__(self, outcomes=["next", "done"])
-        self.budget = budget
-        self.rearm = rearm
+    class Flip(smach.State):
+        def __init__(self, budget: list, rearm: int = 0) -> None:
+            smach.State.__init__(self, outcomes=["next", "done"], io_keys=["count"] if counts else [])
+            self.budget = budget
+            self.rearm = rearm
 
-    def execute(self, ud):
-        budget = self.budget
-        budget[0] -= 1
-        if budget[0] > 0:
-            return "next"
-        budget[0] = self.rearm
-        return "done"
+        def execute(self, ud):
+            if counts:
+                ud.count += 1
+            budget = self.budget
+            budget[0] -= 1
+            if budget[0] > 0:
+                return "next"
+            budget[0] = self.rearm
+            return "done"
+    return Flip
 
 
-def two_state_loop() -> tuple:
+def two_state_loop(smach: Any = smach, userdata: dict | None = None) -> tuple:
+    """A <-> B until LOOP_TRANSITIONS; with ``userdata`` (which must hold ``count``), the machine
+    starts with it and each state adds one to ``count``."""
+    Flip = flip_class(smach, userdata is not None)
     budget = [0]
     sm = smach.StateMachine(outcomes=["done"])
     with sm:
@@ -47,16 +57,19 @@ def two_state_loop() -> tuple:
 
     def run():
         budget[0] = LOOP_TRANSITIONS + 1
+        for key, value in (userdata or {}).items():
+            sm.userdata[key] = value
         assert sm.execute() == "done"
         return LOOP_TRANSITIONS  # LOOP_TRANSITIONS + 1 executions: that many transitions, then termination
     return sm, run
 
 
-def nested_machine() -> tuple:
+def nested_machine(smach: Any = smach, userdata: dict | None = None) -> tuple:
     """ROOT(MID <-> D) > MID(INNER <-> C) > INNER(A <-> B): every level loops between a child
     container and a leaf. One step = one child execution at any level (it ends in a transition
-    or a termination of its parent)."""
+    or a termination of its parent). ``userdata`` as for ``two_state_loop``."""
     steps = [0]
+    Flip = flip_class(smach, userdata is not None)
 
     class Counting(smach.StateMachine):
         def execute(self, parent_ud=None):
@@ -68,12 +81,13 @@ def nested_machine() -> tuple:
             steps[0] += 1
             return Flip.execute(self, ud)
 
+    keys = {"input_keys": ["count"], "output_keys": ["count"]} if userdata is not None else {}
     inner_budget, mid_budget, root_budget = [8], [3], [0]
-    inner = Counting(outcomes=["done"])
+    inner = Counting(outcomes=["done"], **keys)
     with inner:
         smach.StateMachine.add("A", Leaf(inner_budget, rearm=8), transitions={"next": "B"})
         smach.StateMachine.add("B", Leaf(inner_budget, rearm=8), transitions={"next": "A"})
-    mid = Counting(outcomes=["done"])
+    mid = Counting(outcomes=["done"], **keys)
     with mid:
         smach.StateMachine.add("INNER", inner, transitions={"done": "C"})
         smach.StateMachine.add("C", Leaf(mid_budget, rearm=3), transitions={"next": "INNER"})
@@ -85,6 +99,8 @@ def nested_machine() -> tuple:
     def run():
         steps[0] = 0
         root_budget[0] = NESTED_STEPS // 32  # one MID run is 31 steps, plus one D
+        for key, value in (userdata or {}).items():
+            root.userdata[key] = value
         assert root.execute() == "done"
         return steps[0]
     return root, run

@@ -4,18 +4,30 @@ The original's ``UserData`` keeps no record of writes (fsm's tracks the keys wri
 is told by comparing encoded values: at a container's start every key is encoded and kept; at each
 transition and termination every key is encoded again and the keys whose encoding differs (or that
 are new) are the change. A value that is the very same immutable object as last time (a str, an int,
-...) is not encoded again. The userdata is only read, through its ``_data`` dict (read-only; reading
+...), or one of built-in types whose ``marshal`` bytes are those of last time, is not encoded again
+(``marshal`` is C, and runs no user code: what smach_ros pays per transition for its pickle). The userdata is only read, through its ``_data`` dict (read-only; reading
 ``ud._dirty`` or any other missing ``_`` name of the original raises inside its ``__getattr__``).
 """
 
 from __future__ import annotations
 
+import marshal
 from typing import Any
 
 from .encoding import _key, encode
 
 # Values whose identity says they did not change: the same object cannot have changed in place.
 _IMMUTABLE = frozenset((str, int, float, bool, type(None), bytes, complex))
+
+
+def _fingerprint(value: Any) -> bytes | None:
+    """The value's bytes as ``marshal`` writes them, for the built-in types it writes (dicts, lists,
+    numbers, strings, ...; no user code runs): equal bytes, an equal value, so the value need not be
+    encoded again. None for any other value (a user's object, a numpy array), which is encoded each time."""
+    try:
+        return marshal.dumps(value)
+    except (ValueError, TypeError, RecursionError):
+        return None
 
 
 def read(userdata: Any) -> list[tuple[Any, Any]]:
@@ -38,15 +50,15 @@ class UserdataWatch:
     __slots__ = ("_seen",)
 
     def __init__(self) -> None:
-        self._seen: dict[str, tuple[Any, Any]] | None = None  # key -> (value, its encoding)
+        self._seen: dict[str, tuple[Any, bytes | None, Any]] | None = None  # key -> (value, fingerprint, encoding)
 
     def snapshot(self, userdata: Any) -> dict:
         """Every key, encoded (a start's ``userdata``); kept to compare the next changes with."""
         seen = {}
         for key, value in read(userdata):
-            seen[_key(key)] = (value, encode(value))
+            seen[_key(key)] = (value, _fingerprint(value), encode(value))
         self._seen = seen
-        return {k: v[1] for k, v in seen.items()}
+        return {k: v[2] for k, v in seen.items()}
 
     def changes(self, userdata: Any) -> dict:
         """The keys whose encoded value differs from the one last reported (or that are new), encoded."""
@@ -60,10 +72,13 @@ class UserdataWatch:
             before = seen.get(key)
             if before is not None and before[0] is value and type(value) in _IMMUTABLE:
                 continue
+            fingerprint = _fingerprint(value)
+            if before is not None and fingerprint is not None and fingerprint == before[1]:
+                continue
             encoded = encode(value)
-            if before is None or before[1] != encoded:
+            if before is None or before[2] != encoded:
                 changed[key] = encoded
-            seen[key] = (value, encoded)
+            seen[key] = (value, fingerprint, encoded)
         return changed
 
     def forget(self) -> None:

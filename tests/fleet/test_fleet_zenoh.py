@@ -86,8 +86,8 @@ def test_a_dashboard_that_joins_after_the_run_gets_the_whole_run_the_robot_keeps
 
 def test_a_dashboard_that_joins_after_the_robot_let_the_runs_start_go_gets_its_end_as_a_snapshot(quiet,
                                                                                                   monkeypatch):
-    monkeypatch.setattr(fleet.robot, "MAX_BATCH", 16)  # batches of 16 events (the size is looked at every 16)
-    monkeypatch.setattr(fleet.robot, "RING", 3)  # of which the robot keeps the newest
+    monkeypatch.setattr(fsmscope.fleet.robot, "MAX_BATCH", 16)  # batches of 16 events (the size is looked at every 16)
+    monkeypatch.setattr(fsmscope.fleet.robot, "RING", 3)  # of which the robot keeps the newest
     own, dash = run_then_join()
     assert [e["kind"] for e in dash.events] == ["snapshot"] and dash.events[0]["seq"] == own[-1]["seq"]
     assert dash.events[0]["status"]["outcome"] == "done"
@@ -282,7 +282,7 @@ def test_a_closed_robot_keeps_no_more_than_a_batch_of_what_its_machine_still_doe
     robot.close()
     sm.get_children()["A"].count[0] = 0  # the loop ticks its 400 times again
     sm.execute()
-    assert len(robot._machines["loop"].pending) < fleet.robot.MAX_BATCH
+    assert len(robot._machines["loop"].pending) < fsmscope.fleet.robot.MAX_BATCH
 
 
 def test_a_machine_that_first_runs_after_its_robot_closed_runs_unpublished(quiet):

@@ -24,8 +24,16 @@ __all__ = ["init_node", "get_name", "loginfo", "logwarn", "logerr", "logfatal", 
            "Subscriber", "Service", "ServiceProxy", "wait_for_service", "ServiceException", "ROSException",
            "ROSInterruptException"]
 
-loginfo, logwarn, logerr, logdebug = fsm.loginfo, fsm.logwarn, fsm.logerr, fsm.logdebug
-logfatal = fsm.logerr
+
+def _logger(level: Callable[[object], None]) -> Callable[..., None]:
+    def log(msg: Any, *args: Any, **kwargs: Any) -> None:
+        """A line, formatted with ``args`` as rospy's (``loginfo("at %d", n)``), through fsm's log."""
+        level(str(msg) % args if args else msg)
+    return log
+
+
+loginfo, logwarn, logerr, logdebug, logfatal = map(_logger, (fsm.loginfo, fsm.logwarn, fsm.logerr, fsm.logdebug,
+                                                             fsm.logerr))
 
 
 class ROSException(Exception):

@@ -97,3 +97,9 @@ def test_a_machine_stops_when_the_node_shuts_down_as_with_smach_ros(ros):
         smach.StateMachine.add("A", smach.CBState(once, outcomes=["again"]), transitions={"again": "A"})
     sm.execute()
     assert seen == [1]
+
+
+def test_rospy_log_lines_are_formatted_with_their_arguments_and_go_through_fsms_log(ros, logs):
+    ros["rospy"].loginfo("Executing state %s (%d)", "FOO", 3)
+    ros["rospy"].logwarn("100% sure")
+    assert (logs.info, logs.warn) == (["Executing state FOO (3)"], ["100% sure"])

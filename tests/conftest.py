@@ -9,7 +9,9 @@ Each folder is a layer, registered as a marker of the same name (``pytest -m uni
 * ``browser/``: real Chromium (and Firefox) against real servers;
 * ``demo/``: the real ``fsmscope demo`` (MuJoCo, viser): a recorded episode, and one live process
   shared by its tests (demo/conftest.py);
-* ``parity/``: fsm and the original SMACH run side by side.
+* ``parity/``: fsm and the original SMACH run side by side;
+* ``ros1/``: a real ROS 1 (Debian's rosmaster, rospy and rostopic) and a robot on the original SMACH
+  with smach_ros, watched by fsmscope (tests/ros1_support.py).
 
 Shared fixtures: captured log lines, the runtime's globals restored after every test, a live server,
 a private bus and its action servers, Debian's Chromium, and one recorded demo episode."""
@@ -167,7 +169,7 @@ def headless_demo_log(tmp_path_factory):
     return path
 
 
-LAYERS = ("unit", "server", "fleet", "browser", "demo", "parity")
+LAYERS = ("unit", "server", "fleet", "browser", "demo", "parity", "ros1")
 TESTS = Path(__file__).resolve().parent
 
 
@@ -195,7 +197,8 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     layers: dict[str | None, list[list[pytest.Item]]] = {}
     for tests in sorted(modules.values(), key=len, reverse=True):
         layers.setdefault(layer_of(tests[0]), []).append(tests)
-    in_turns = itertools.zip_longest(*(layers.pop(layer, []) for layer in ("browser", "fleet", "server", "parity")))
+    in_turns = itertools.zip_longest(*(layers.pop(layer, [])
+                                       for layer in ("browser", "fleet", "server", "parity", "ros1")))
     ordered = layers.pop("demo", []) + [tests for turn in in_turns for tests in turn if tests]
     ordered += [tests for rest in layers.values() for tests in rest]  # the unit layer
     items[:] = [item for tests in ordered for item in tests]

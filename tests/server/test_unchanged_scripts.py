@@ -95,19 +95,23 @@ def served_run(script, log, pythonpath=None):
             proc.wait()
 
 
+def runs_again_from_the_dashboard(http, machine, outcome):
+    """The served ``machine`` ended in ``outcome``; started again from the dashboard, it ends so again."""
+    status = http.get("/api/machines/%s/status" % machine).json()
+    assert (status["running"], status["outcome"]) == (False, outcome)
+    assert http.post("/api/machines/%s/start" % machine, json={}).status_code == 202
+
+    def the_new_run_ended():
+        now = http.get("/api/machines/%s/status" % machine).json()
+        return now["run"] != status["run"] and not now["running"] and now["outcome"] == outcome
+    wait_for(the_new_run_ended, 10, interval=0.02, what="the run started from the dashboard to end")
+
+
 def test_a_tutorials_machine_is_served_and_runs_again_from_the_dashboard_after_the_script_ended(tmp_path):
     log = tmp_path / "run.jsonl"
     with served_run(os.path.join(EXAMPLES, "tutorial_foo_bar.py"), log) as http:
-        status = http.get("/api/machines/tutorial_foo_bar/status").json()
-        assert (status["running"], status["outcome"]) == (False, "outcome4")
-        assert http.post("/api/machines/tutorial_foo_bar/start", json={}).status_code == 202
-
-        def the_new_run_ended():
-            now = http.get("/api/machines/tutorial_foo_bar/status").json()
-            return now["run"] != status["run"] and not now["running"] and now["outcome"] == "outcome4"
-        wait_for(the_new_run_ended, 10, interval=0.02, what="the run started from the dashboard to end")
-    summary = json.loads(cli("replay", log, "--json").stdout)
-    assert summary["machines"]["tutorial_foo_bar"]["runs"] == 2
+        runs_again_from_the_dashboard(http, "tutorial_foo_bar", "outcome4")
+    assert json.loads(cli("replay", log, "--json").stdout)["machines"]["tutorial_foo_bar"]["runs"] == 2
 
 
 def test_a_ros_import_without_a_counterpart_fails_naming_the_module(tmp_path):
@@ -228,11 +232,12 @@ build().execute()
 
 
 @needs_original
-def test_a_machine_of_the_original_smach_is_served_on_the_dashboard(tmp_path):
-    with served_run(write_script(tmp_path, FOO_BAR_ON_SMACH), tmp_path / "run.jsonl", ORIGINAL_SRC) as http:
+def test_a_machine_of_the_original_smach_is_served_and_runs_again_from_the_dashboard(tmp_path):
+    log = tmp_path / "run.jsonl"
+    with served_run(write_script(tmp_path, FOO_BAR_ON_SMACH), log, ORIGINAL_SRC) as http:
         assert [m["name"] for m in http.get("/api/machines").json()] == ["task"]
-        status = http.get("/api/machines/task/status").json()
-        assert (status["running"], status["outcome"]) == (False, "outcome4")
+        runs_again_from_the_dashboard(http, "task", "outcome4")
+    assert json.loads(cli("replay", log, "--json").stdout)["machines"]["task"]["runs"] == 2
 
 
 @needs_original

@@ -103,3 +103,14 @@ def test_rospy_log_lines_are_formatted_with_their_arguments_and_go_through_fsms_
     ros["rospy"].loginfo("Executing state %s (%d)", "FOO", 3)
     ros["rospy"].logwarn("100% sure")
     assert (logs.info, logs.warn) == (["Executing state FOO (3)"], ["100% sure"])
+
+
+def test_a_condition_state_polls_at_a_rospy_duration_until_its_condition_holds(ros):
+    smach, smach_ros, rospy = ros["smach"], ros["smach_ros"], ros["rospy"]
+    checks = []
+    sm = smach.StateMachine(outcomes=["true", "false", "preempted"])
+    with sm:
+        smach.StateMachine.add("WAIT", smach_ros.ConditionState(lambda ud: checks.append(1) or len(checks) == 3,
+                                                                poll_rate=rospy.Duration(0.01), max_checks=-1))
+    assert sm.execute() == "true"
+    assert len(checks) == 3

@@ -215,6 +215,12 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
     return node
 
 
+# The reporters of machines of another runtime: ``make(machine, name, path)`` gives one bound to the
+# machine, or None when the machine is not of that runtime. fsm/observation/original.py registers the
+# original SMACH's (fsm/observation/__init__.py imports it, so it is registered wherever attach is).
+foreign_reporters: list[Callable[[Any, str, str], Reporter | None]] = []
+
+
 def attach(machine: Any, observer: Observer | None = None, name: str | None = None,
            path: str = DEFAULT_ROOT_PATH) -> Reporter:
     """Observe a top-level container, of fsm or of the original SMACH (fsm/observation/original.py);
@@ -224,10 +230,8 @@ def attach(machine: Any, observer: Observer | None = None, name: str | None = No
     rep = getattr(machine, "_reporter", None)
     if rep is None or rep.root is not machine:
         name = names.check(name) if name else names.valid(path.rsplit("/", 1)[-1] or "SM_ROOT")
-        from . import original  # here: it builds on this module
-        if original.is_original(machine):
-            rep = original.attach(machine, name, path)
-        else:
+        rep = next(filter(None, (make(machine, name, path) for make in foreign_reporters)), None)
+        if rep is None:
             rep = Reporter(machine, name, path)
             machine._reporter = rep
             machine._path = path

@@ -27,7 +27,7 @@ from typing import Any
 
 from ..core.state import State
 from . import original_log, schema
-from .introspection import Reporter, _never_raising, class_doc
+from .introspection import Reporter, _never_raising, class_doc, foreign_reporters
 from .original_container import ContainerWatch, PreemptWatched, Watched, is_concurrence
 from .schema import ABSENT, build
 from .structure import children, is_container
@@ -137,29 +137,39 @@ def _describe(state: Any, label: str, path: str, rep: OriginalReporter, parent: 
 
 def _hook(state: Any, rep: OriginalReporter, path: str, parent: ContainerWatch | None, label: str,
           container: bool) -> ContainerWatch | None:
-    """Bind ``state`` to ``rep`` at ``path`` (hooking it the first time); returns its own watch if a container."""
-    state._reporter = rep
-    state._path = path
+    """Bind ``state`` to ``rep`` at ``path`` (hooking it the first time); returns its own watch if a
+    container. A state that takes no attribute (``__slots__``) is described, not watched."""
+    try:
+        state._reporter = rep
+        state._path = path
+    except AttributeError:
+        return None
     own = None
     if container:
         own = getattr(state, "_fsm_watch", None)
         if own is None:
             own = state._fsm_watch = ContainerWatch(state)
             state._report_changes = own.report_changes  # what fsm's debugger calls before a hold
-        own.bind(rep, path, parent is None)
+        own.bind(rep, path, path == rep.root_path)
     execute = state.execute
     if not isinstance(execute, Watched):
         execute = state.execute = Watched(state, execute)
-    execute.parent, execute.label, execute.own = parent, label, own
-    if container and not isinstance(state.request_preempt, PreemptWatched):
-        state.request_preempt = PreemptWatched(state, state.request_preempt, "requested")
-    if not isinstance(state.service_preempt, PreemptWatched):
-        state.service_preempt = PreemptWatched(state, state.service_preempt, "serviced")
+    execute.parent, execute.label, execute.own, execute.root = parent, label, own, path == rep.root_path
+    for name, phase in (("request_preempt", "requested"), ("service_preempt", "serviced")):
+        method = getattr(state, name, None)
+        if method is not None and not isinstance(method, PreemptWatched) and (container or phase == "serviced"):
+            setattr(state, name, PreemptWatched(state, method, phase))
     return own
 
 
-def attach(machine: Any, name: str, path: str) -> OriginalReporter:
-    """A reporter for an original machine, its tree hooked and bound to it."""
+def attach(machine: Any, name: str, path: str) -> OriginalReporter | None:
+    """A reporter for a machine of the original SMACH, its tree hooked and bound to it (None for
+    another machine): what ``fsm.attach`` makes for one."""
+    if not is_original(machine):
+        return None
     rep = OriginalReporter(machine, name, path)
     rep.structure()
     return rep
+
+
+foreign_reporters.append(attach)

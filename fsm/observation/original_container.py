@@ -55,8 +55,7 @@ class ContainerWatch:
         self.concurrent = is_concurrence(container)
         self.userdata = UserdataWatch()
         self._lock = threading.RLock()  # a Concurrence's children call in from their threads
-        self.active = [s for s in _labels(container.get_active_states()) if s != "None"]  # running when watched?
-        self.entered = False  # its execute (wrapped) is running: set on entry, before its start
+        self.active = [s for s in _labels(container.get_active_states()) if s != "None"]  # it may be running
         self.started = False  # its start callback came in this run
         self.ended = False  # its terminate event was sent in this run
         self.last: tuple[str, str] | None = None  # the (label, outcome) a child returned last
@@ -151,11 +150,10 @@ class ContainerWatch:
 
     def entering(self) -> None:
         """Its own ``execute`` begins (before its start callback, if it gets that far)."""
-        self.entered, self.started, self.ended = True, False, False
+        self.started, self.ended = False, False
 
     def left(self, exc: BaseException | None) -> None:
         """Its own ``execute`` ended: raising ``exc``, or without a terminate (no outcome)."""
-        self.entered = False
         if self.ended:
             return
         self.ended = True
@@ -259,15 +257,16 @@ class Watched:
         self.parent: ContainerWatch | None = None  # its container's watch (None: the root)
         self.label = ""
         self.own: ContainerWatch | None = None  # its own watch, when it is a container
+        self.root = False  # it is the watched machine's root: its call is a run
 
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
-        parent, own, label = self.parent, self.own, self.label
+        parent, own, label, root = self.parent, self.own, self.label, self.root
         watch = own if own is not None else parent
         rep = watch.rep if watch is not None else None
         prev = reporting.enter(rep, watch.path) if rep is not None else reporting.NOT_ENTERED
         try:
             if own is not None:
-                if parent is None and rep is not None:
+                if root and rep is not None:
                     rep.root_entered()
                 own.entering()
             container = parent.container if parent is not None else None
@@ -291,13 +290,15 @@ class Watched:
                 parent.returned(label, outcome)
             return outcome
         finally:
-            if own is not None and parent is None and rep is not None:
+            if root and rep is not None:
                 rep.root_left()
-            if prev is not None or parent is None or not parent.concurrent:
+            if prev is None and parent is not None and parent.concurrent and rep is not None:
+                # A thread the original's Concurrence started for this child, which ends once the
+                # child's outcome is taken: the lines it logs until then (SMACH's wrapping of the
+                # child's exception, its word of a missing outcome) are the Concurrence's.
+                reporting.enter(rep, parent.path)
+            else:
                 reporting.leave(prev)
-            # else: a thread the original's Concurrence started for this child, which ends once the
-            # child's outcome is taken: the lines it logs until then (SMACH's wrapping of the
-            # child's exception, its word of a missing outcome) stay the Concurrence's.
 
 
 class PreemptWatched:

@@ -99,6 +99,20 @@ def raising_child(side: Side) -> Any:
     return k.machine(["done"], [("CC", cc, {})])
 
 
+def raising_grandchild(side: Side) -> Any:
+    """ROOT > CC, a Concurrence whose child SUB, a machine, runs INNER, which raises once GOOD has returned."""
+    k = kit(side.sm)
+    good_done = side.when_logged("Concurrent state 'GOOD' returned")
+
+    def inner(ud):
+        good_done.wait(5)
+        raise RuntimeError("grandchild failed")
+
+    sub = k.machine(["done"], [("INNER", k.Out(inner), {})])
+    cc = k.concurrence(["done"], "done", [("GOOD", k.Out("done")), ("SUB", sub)])
+    return k.machine(["done"], [("CC", cc, {})])
+
+
 def preempted(side: Side) -> Any:
     """ROOT > SUB > WAIT, which blocks until preempted; the root is preempted once WAIT runs."""
     k = kit(side.sm)
@@ -149,12 +163,13 @@ def iterated(side: Side) -> Any:
 
 
 SCENARIOS: dict[str, Callable[[Side], Any]] = {
-    "loop": loop, "nested": nested, "raising": raising, "raising_child": raising_child, "preempted": preempted,
+    "loop": loop, "nested": nested, "raising": raising, "raising_child": raising_child,
+    "raising_grandchild": raising_grandchild, "preempted": preempted,
     "preempted_concurrence": preempted_concurrence, "iterated": iterated}
 # Where two threads log at once: the original's Concurrence wakes as its child raises, and logs that
 # it preempts the others while the child's thread words the exception. Their lines are compared in
 # any order.
-RACY = {"raising_child"}
+RACY = {"raising_child", "raising_grandchild"}
 
 
 def lines(seen: dict, scenario: str) -> list:

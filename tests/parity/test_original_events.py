@@ -94,15 +94,30 @@ def _by_path(events):
     return paths
 
 
-@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
-def test_a_machine_of_the_original_sends_the_events_the_same_machine_sends_on_fsm(original, scenario, tmp_path):
-    theirs = run(original, SCENARIOS[scenario], tmp_path / "original.jsonl")["events"]
+@pytest.mark.parametrize("scenario", sorted(set(SCENARIOS) - {"raising_grandchild"}))
+def test_a_machine_of_the_original_sends_the_events_the_same_machine_sends_on_fsm(core, scenario, tmp_path):
+    if scenario == "preempted_concurrence" and "/ros2/" in core.__file__:
+        pytest.skip("the ros2 branch's Concurrence, its children's preempt serviced, goes on to its outcome map "
+                    "(noetic-devel's and fsm's end 'preempted'): another run, not another way of watching it")
+    theirs = run(core, SCENARIOS[scenario], tmp_path / "original.jsonl")["events"]
     ours = run(fsm, SCENARIOS[scenario], tmp_path / "fsm.jsonl")["events"]
     assert _by_path(theirs) == _by_path(ours)
     assert normalised(theirs[0]["root"]) == normalised(ours[0]["root"])
 
 
-def test_where_userdata_events_differ_from_fsms_a_change_is_a_value_that_differs_not_a_write(original, tmp_path):
+def test_where_the_runtimes_differ_the_events_say_what_each_did(core, tmp_path):
+    """A Concurrence child that is a machine and raises: the original's Concurrence then asks it to
+    preempt (it preempts every child without an outcome, the failed one too; fsm's skips it), and
+    its watched machine says so with a preempt event that fsm's run has not. The rest is the same."""
+    theirs = _by_path(run(core, SCENARIOS["raising_grandchild"], tmp_path / "original.jsonl")["events"])
+    ours = _by_path(run(fsm, SCENARIOS["raising_grandchild"], tmp_path / "fsm.jsonl")["events"])
+    asked = {"kind": "preempt", "path": "/SM_ROOT/CC/SUB", "phase": "requested"}
+    assert asked in theirs["/SM_ROOT/CC/SUB"] and asked not in ours["/SM_ROOT/CC/SUB"]
+    theirs["/SM_ROOT/CC/SUB"].remove(asked)
+    assert theirs == ours
+
+
+def test_where_userdata_events_differ_from_fsms_a_change_is_a_value_that_differs_not_a_write(core, tmp_path):
     """fsm tracks the keys a state writes; the original's UserData keeps no such record, so a change is
     a value that differs from the last reported one (original_userdata.py). A list appended to in
     place is a change on the original (fsm shows it at the container's next start), and a key written
@@ -129,5 +144,5 @@ def test_where_userdata_events_differ_from_fsms_a_change_is_a_value_that_differs
         events = run(sm, scenario, tmp_path / log)["events"]
         return [(e["kind"], e.get("from"), e.get("changes")) for e in events if e["kind"] in ("userdata", "transition")]
 
-    assert changes(original, "original.jsonl") == [("userdata", None, {"items": [1]}), ("transition", "APPEND", None)]
+    assert changes(core, "original.jsonl") == [("userdata", None, {"items": [1]}), ("transition", "APPEND", None)]
     assert changes(fsm, "fsm.jsonl") == [("transition", "APPEND", None), ("userdata", None, {"n": 5})]

@@ -129,3 +129,36 @@ def test_fsms_debugger_holds_an_original_machine_through_the_execute_wrappers_ga
     forced = [e for e in events if e["kind"] == "debug" and e["action"] == "forced"]
     assert [(e["state"], e["outcome"], e["returned"]) for e in forced] == [("BAR", "failed", None)]
     debugger.detach()
+
+
+def test_a_state_that_takes_no_attribute_is_described_and_its_machine_watched(core):
+    """SMACH runs any object with its interface; one with ``__slots__`` cannot be hooked: it is in the
+    structure, and its container's events still tell the run (the outcome read from the edges)."""
+    quiet(core)
+
+    class Slotted:
+        __slots__ = ()
+
+        def get_registered_outcomes(self):
+            return ("done",)
+
+        def get_registered_input_keys(self):
+            return ()
+
+        def get_registered_output_keys(self):
+            return ()
+
+        def execute(self, ud):
+            return "done"
+
+        def preempt_requested(self):
+            return False
+
+    k = kit(core)
+    sm = k.machine(["end"], [("SLOT", Slotted(), {"done": "LAST"}), ("LAST", k.Out("end"), {})])
+    events = []
+    fsm.attach(sm, events.append)
+    assert sm.execute() == "end"
+    assert [c["label"] for c in events[0]["root"]["children"]] == ["SLOT", "LAST"]
+    assert [(e["kind"], e.get("from"), e.get("outcome")) for e in events[1:]] == [
+        ("start", None, None), ("transition", "SLOT", "done"), ("terminate", None, "end")]

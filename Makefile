@@ -5,10 +5,11 @@ STAMP    := $(VENV)/.installed
 # Debian packages the tests and the demo need: Graphviz's dot for graph layout, Chromium and
 # Firefox ESR for the browser tests, openssl for the fleet's TLS test certificates, and ROS 1 as
 # Debian packages it for the tests of a real ROS 1 robot (tests/ros1/): rospy, a master, rostopic,
-# genpy and std_msgs's .msg files (to generate smach_msgs' classes), actionlib (smach_ros imports it).
+# genpy and std_msgs's .msg files (to generate smach_msgs' classes), actionlib (smach_ros imports it),
+# std_srvs (examples/tutorial_service_action.py's service).
 APT_PKGS := graphviz chromium firefox-esr fonts-dejavu-core openssl \
             python3-rospy python3-rosmaster python3-rostopic python3-rosbag python3-genpy python3-genmsg \
-            python3-std-msgs ros-std-msgs python3-actionlib python3-roslaunch
+            python3-std-msgs ros-std-msgs python3-actionlib python3-roslaunch python3-std-srvs
 
 .PHONY: install apt demo test test-fast bench clean
 

@@ -1,7 +1,8 @@
 """``fsmscope run``: run a user's SMACH-style script as ``__main__`` and record every machine it runs.
 
 The script does not know: a global introspection hook attaches a Recorder to each
-top-level machine the first time it starts, naming it after the script (``foo_bar``,
+top-level machine the first time it starts (an fsm machine through ``fsm.add_global_hook``, one of
+the original smach through ``original_machines``), naming it after the script (``foo_bar``,
 then ``foo_bar-2`` for a second machine: fsm/observation/names.py). Whoever serves a dashboard registers
 ``on_machine`` callbacks to attach its own observers to the same machines (they run in
 the machine's thread, before its first event).
@@ -9,6 +10,10 @@ the machine's thread, before its first event).
 With ``keep_open`` the log stays open after the script ends (``fsmscope run`` keeps serving the
 dashboard, where POST .../start re-runs a machine: those runs are recorded too) until
 ``close()``, which writes what is left, fsyncs and says what was recorded.
+
+A script that does ``import smach`` runs as it is: on the original smach where it is installed, and
+otherwise on fsm with ROS-free counterparts of smach, smach_ros and rospy (fsmscope/counterparts/,
+installed for the run only by ``ScriptImports``; docs/guide.md, "Unchanged SMACH scripts").
 
 A log is never written onto unless asked (``append``): a command refuses a file that exists
 (``open_recorder``), as ``import`` and ``export`` do.
@@ -31,6 +36,9 @@ import fsm
 from fsm.observation import names
 from fsm.observation.introspection import reporter_of
 from fsm.logfiles.recorder import Recorder
+from fsmscope.counterparts.finder import ScriptImports
+
+from .original_machines import OriginalMachines
 
 MachineCallback = Callable[[str, Any], None]
 EXIT_NOT_RECORDED = 1  # the script ended well, but its log could not be written whole
@@ -87,6 +95,7 @@ class Runner:
         self.record_path = self.record or ""  # the default's name is found when the log is opened (prepare)
         self._lock = threading.Lock()
         self._restore_sigterm: Callable[[], None] = lambda: None
+        self._originals: list[OriginalMachines] = []
 
     def _hook(self, container: Any) -> None:
         with self._lock:
@@ -131,6 +140,8 @@ class Runner:
             sys.path.insert(0, os.path.dirname(script))
         self._restore_sigterm = _sigterm_as_exit(self._note_signal)
         fsm.add_global_hook(self._hook)
+        imports = ScriptImports(self._watch_original, lambda line: sys.stderr.write("fsmscope: %s\n" % line))
+        imports.install()
         code = 0
         try:
             runpy.run_path(script, run_name="__main__")
@@ -144,12 +155,19 @@ class Runner:
             code = 1
         finally:
             fsm.remove_global_hook(self._hook)
+            imports.uninstall()
+            for originals in self._originals:
+                originals.stop()
+            self._originals.clear()
             sys.argv = saved_argv
             if saved_path0 is not None and sys.path:
                 sys.path[0] = saved_path0
             if not self.keep_open:
                 self.close()
         return code if self.keep_open else self.exit_code(code)
+
+    def _watch_original(self, smach: Any) -> None:
+        self._originals.append(OriginalMachines(smach, self._hook))
 
     def _note_signal(self, signum: int) -> None:
         self.signalled = signum

@@ -100,3 +100,12 @@ def test_the_installed_command_runs_and_records_an_example(installed):
     replayed = installed.run("fsmscope", "replay", str(log))
     assert replayed.returncode == 0, replayed.stderr
     assert "/SM_ROOT: FOO --outcome2--> end  x1" in replayed.stdout
+
+
+def test_the_installed_command_runs_an_unchanged_ros_tutorial_on_its_counterparts(installed):
+    log = installed.cwd / "tutorial.jsonl"
+    done = installed.run("fsmscope", "run", "--no-serve", os.path.join(EXAMPLES, "tutorial_service_action.py"),
+                         "--record", str(log))
+    assert done.returncode == 0, done.stderr
+    assert "smach is not installed: running the script on fsm" in done.stderr
+    assert "The state machine ended in succeeded with sum=5" in done.stdout

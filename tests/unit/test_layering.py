@@ -5,7 +5,8 @@ the simulator. Inside fsm the core imports nothing but itself: it reports throug
 (fsm/core/reporting.py), which observation implements; no extension (ros, logfiles, debugging,
 control) is imported by what it extends. sim never imports
 server; interop (bags, MCAP, Foxglove) and fleet (Zenoh) import neither; server imports sim, interop
-and fleet only in its composition root, the CLI (fsmscope/server/cli/).
+and fleet only in its composition root, the CLI (fsmscope/server/cli/). The ROS-free counterparts a
+script's run is given (fsmscope/counterparts/) import only fsm and themselves.
 """
 
 from __future__ import annotations
@@ -189,3 +190,13 @@ def test_the_cycle_check_sees_a_cycle_through_a_function_and_type_checking(tmp_p
     (tmp_path / "pkg" / "d.py").write_text("from . import a\n")
     monkeypatch.setattr(sys.modules[__name__], "ROOT", tmp_path)
     assert cycles(import_graph("pkg")) == [["pkg.a", "pkg.b", "pkg.c"]]
+
+
+def test_the_counterparts_of_ros_import_only_fsm_and_themselves():
+    """fsmscope/counterparts/ stands in for smach, rospy... in a script's run: nothing of the server,
+    the simulator, interop or the fleet is loaded with them."""
+    own = "fsmscope.counterparts"
+    wrong = [where(path, line, module) for path in python_files(own) for line, module in imported_modules(path)
+             if module.split(".")[0] not in sys.stdlib_module_names | {"fsm", "__future__"}
+             and module != own and not module.startswith(own + ".")]
+    assert wrong == []

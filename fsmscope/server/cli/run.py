@@ -24,8 +24,9 @@ PASSES_ARGUMENTS_ON = True
 
 def arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("script", metavar="FILE.py",
-                        help="a SMACH-style script, run as __main__; arguments fsmscope does not know, and "
-                             "all after '--', are passed to it")
+                        help="a SMACH script, run as __main__ as it is (its 'import smach' is the original where "
+                             "installed, else fsm with ROS-free rospy and smach_ros); arguments fsmscope does not "
+                             "know, and all after '--', are passed to it")
     parser.add_argument("--record", metavar="RUN.jsonl",
                         help="where to record the events, a new file (default: runs/<script>-<timestamp>.jsonl)")
     parser.add_argument("--append", action="store_true", help="with --record: add to the log if it exists")

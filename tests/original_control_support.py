@@ -12,7 +12,7 @@ from fsmscope import Publisher
 from fsmscope.server.testing.polling import wait_for
 
 from original_core import loaded_original
-from server_support import client
+from server_support import client, looping_machine
 
 
 @pytest.fixture(scope="module", params=["noetic", "ros2"])
@@ -21,26 +21,6 @@ def smach(request):
     with loaded_original(request.param) as module:
         module.set_loggers(*[lambda msg: None] * 4)
         yield module
-
-
-def looping(smach):
-    """A <-> B of the original, until ``stop`` is set; each writes its count into userdata ``n``."""
-    stop = threading.Event()
-    count = {"n": 0}
-
-    def tick(ud):
-        time.sleep(0.002)
-        count["n"] += 1
-        ud.n = count["n"]
-        return "stop" if stop.is_set() else "go"
-
-    sm = smach.StateMachine(outcomes=["done"])
-    with sm:
-        smach.StateMachine.add("A", smach.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
-                               {"go": "B", "stop": "done"})
-        smach.StateMachine.add("B", smach.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
-                               {"go": "A", "stop": "done"})
-    return sm, stop
 
 
 def visiting(smach):
@@ -113,7 +93,7 @@ def controls(http, name, action=None):
 @pytest.fixture
 def loop(live_server, smach):
     """The looping original machine served as 'loop', running in a thread; stopped and resumed at the end."""
-    sm, stop = looping(smach)
+    sm, stop = looping_machine(smach)
     live_server.hub.add_local(sm, name="loop")
     http = client(live_server)
     thread, result = run_in_thread(sm)

@@ -15,7 +15,6 @@ from __future__ import annotations
 import os
 import re
 import shutil
-import signal
 import subprocess
 import sys
 import threading
@@ -24,7 +23,7 @@ from pathlib import Path
 
 import httpx
 import pytest
-from fsmscope.server.testing.demo_process import free_port
+from fsmscope.server.testing.demo_process import free_port, interrupt
 from fsmscope.server.testing.polling import wait_for
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -175,13 +174,7 @@ class Robot:
 
     def stop(self, timeout: float = 20) -> int:
         """SIGINT, as Ctrl-C or roslaunch would: rospy shuts the node down; returns the exit code."""
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGINT)
-            try:
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait()
+        interrupt(self.proc, timeout)
         self._reader.join(5)
         return self.proc.returncode
 

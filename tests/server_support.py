@@ -142,8 +142,9 @@ def blob_loop(n, size=2000):
     return sm
 
 
-def looping_machine():
-    """A <-> B until ``stop`` is set; each writes its count into userdata ``n``."""
+def looping_machine(smach=fsm):
+    """A <-> B until ``stop`` is set; each writes its count into userdata ``n``. ``smach``: fsm, or
+    the original SMACH (tests/original_control_support.py)."""
     stop = threading.Event()
     count = {"n": 0}
 
@@ -153,10 +154,10 @@ def looping_machine():
         ud.n = count["n"]
         return "stop" if stop.is_set() else "go"
 
-    sm = fsm.StateMachine(outcomes=["done"])
+    sm = smach.StateMachine(outcomes=["done"])
     with sm:
-        fsm.StateMachine.add("A", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
-                             {"go": "B", "stop": "done"})
-        fsm.StateMachine.add("B", fsm.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
-                             {"go": "A", "stop": "done"})
+        smach.StateMachine.add("A", smach.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
+                               {"go": "B", "stop": "done"})
+        smach.StateMachine.add("B", smach.CBState(tick, outcomes=["go", "stop"], output_keys=["n"]),
+                               {"go": "A", "stop": "done"})
     return sm, stop

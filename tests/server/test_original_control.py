@@ -11,9 +11,9 @@ from fsmscope.server.http_server import ServerThread
 from fsmscope.server.lease import Deadman
 from fsmscope.server.testing.polling import wait_for
 
-from original_control_support import (controls, holds, loop, looping, run_in_thread, smach, status,  # noqa: F401
+from original_control_support import (controls, holds, loop, run_in_thread, smach, status,  # noqa: F401
                                       visiting, waiter, waiting)
-from server_support import client
+from server_support import client, looping_machine
 
 
 # Preempt, initial state, start.
@@ -143,7 +143,7 @@ def test_start_runs_an_original_machine_holding_a_state_with_nothing_but_execute
 
 
 def test_an_initial_state_set_while_the_original_machine_runs_takes_effect_at_its_next_run(live_server, smach):
-    sm, stop = looping(smach)
+    sm, stop = looping_machine(smach)
     live_server.hub.add_local(sm, name="loop")
     http = client(live_server)
     thread, _ = run_in_thread(sm)
@@ -204,7 +204,7 @@ def test_a_control_without_the_lease_of_an_original_machine_is_409_and_in_its_au
 @contextlib.contextmanager
 def serving_with_deadman(smach, after):
     srv = ServerThread(deadman=Deadman(after, "pause")).start()
-    sm, stop = looping(smach)
+    sm, stop = looping_machine(smach)
     srv.hub.add_local(sm, name="loop")
     thread, _ = run_in_thread(sm)
     try:

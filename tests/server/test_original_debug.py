@@ -8,9 +8,9 @@ import threading
 import pytest
 from fsmscope.server.testing.polling import wait_for
 
-from original_control_support import (holds, loop, looping, published, run_in_thread, smach,  # noqa: F401
+from original_control_support import (holds, loop, published, run_in_thread, smach,  # noqa: F401
                                       split_machine, status, visiting, waiter, waiting)
-from server_support import client
+from server_support import client, looping_machine
 
 
 def test_pause_holds_an_original_machine_and_resume_lets_it_finish(loop):
@@ -278,7 +278,7 @@ def test_a_preempt_reaches_an_original_machine_held_inside_its_concurrence(live_
 
 
 def test_a_published_original_machine_is_paused_and_forced_from_the_page(live_server, smach):
-    sm, _ = looping(smach)
+    sm, _ = looping_machine(smach)
     with published(live_server, sm) as (thread, result):
         http = client(live_server)
         assert http.post("/api/machines/remote/pause").status_code == 202

@@ -23,6 +23,19 @@ def free_port() -> int:
         return s.getsockname()[1]
 
 
+def interrupt(proc: subprocess.Popen, timeout: float) -> int:
+    """SIGINT to the process group ``proc`` leads (started with ``start_new_session``), as Ctrl-C
+    would; SIGKILL if it has not exited within ``timeout`` s. Returns the exit code."""
+    if proc.poll() is None:
+        os.killpg(proc.pid, signal.SIGINT)
+        try:
+            proc.wait(timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    return proc.returncode
+
+
 def free_endpoint() -> str:
     """A Zenoh endpoint, ``tcp/127.0.0.1:PORT``, on a port free right now (the fleet's tests and benches)."""
     return "tcp/127.0.0.1:%d" % free_port()
@@ -59,13 +72,7 @@ class DemoProcess:
 
     def stop(self, timeout: float = 20.0) -> int:
         """SIGINT, as Ctrl-C would; returns the exit code."""
-        if self.proc.poll() is None:
-            os.killpg(self.proc.pid, signal.SIGINT)
-            try:
-                self.proc.wait(timeout)
-            except subprocess.TimeoutExpired:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-                self.proc.wait()
+        interrupt(self.proc, timeout)
         if self.proc.stdout is not None:
             self.rest = self.proc.stdout.read()
             self.proc.stdout.close()

@@ -191,9 +191,11 @@ def class_doc(cls: type) -> str | None:
     return first if len(first) <= MAX_DOC else first[:MAX_DOC - 1] + "…"
 
 
-def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict) -> dict:
-    state._reporter = rep
-    state._path = path
+def describe_node(state: Any, label: str, path: str, remapping: dict,
+                  describe_child: Callable[[Any, str, str, dict], dict]) -> dict:
+    """The ``structure`` event's node of ``state``, as every runtime reads it through SMACH's
+    interface; a container's children are described by ``describe_child(child, label, path,
+    remapping)`` (each runtime binds its observer to the states it visits)."""
     doc = class_doc(type(state))
     container = is_container(state)
     node = schema.node(label, path, type(state).__name__, container, sorted(map(str, state.get_registered_outcomes())),
@@ -202,16 +204,25 @@ def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict)
                        {str(k): str(v) for k, v in (remapping or {}).items()}, ABSENT if doc is None else doc)
     if not container:
         return node
-    if state.userdata._dirty is None:
-        state.userdata.track_writes()
-    remappings = getattr(state, "_remappings", {})
+    remappings = getattr(state, "_remappings", None) or {}
     node.update(schema.container_fields(
         [str(s) for s in state.get_initial_states()],
         [schema.edge(str(frm), str(outcome), None if to is None else str(to))
          for outcome, frm, to in state.get_internal_edges()],
-        [_describe(child, str(lbl), path + "/" + str(lbl), rep, remappings.get(lbl, {}))
+        [describe_child(child, str(lbl), path + "/" + str(lbl), remappings.get(lbl, {}))
          for lbl, child in children(state).items()]))
-    node.update(state._introspection_info())
+    return node
+
+
+def _describe(state: Any, label: str, path: str, rep: Reporter, remapping: dict) -> dict:
+    state._reporter = rep
+    state._path = path
+    if is_container(state) and state.userdata._dirty is None:
+        state.userdata.track_writes()
+    node = describe_node(state, label, path, remapping,
+                         lambda child, lbl, at, remap: _describe(child, lbl, at, rep, remap))
+    if node["container"]:
+        node.update(state._introspection_info())
     return node
 
 

@@ -26,10 +26,10 @@ import uuid
 from typing import Any
 
 from ..core.state import State
-from . import original_log, schema
-from .introspection import Reporter, _never_raising, class_doc, foreign_reporters
+from . import original_log
+from .introspection import Reporter, _never_raising, describe_node, foreign_reporters
 from .original_container import ContainerWatch, PreemptWatched, Watched
-from .schema import ABSENT, build
+from .schema import build
 from .structure import children, is_concurrence, is_container
 
 
@@ -109,22 +109,11 @@ def tree_signature(root: Any) -> tuple:
 
 def _describe(state: Any, label: str, path: str, rep: OriginalReporter, parent: ContainerWatch | None,
               remapping: dict) -> dict:
-    container = is_container(state)
-    own = _hook(state, rep, path, parent, label, container)
-    doc = class_doc(type(state))
-    node = schema.node(label, path, type(state).__name__, container, sorted(map(str, state.get_registered_outcomes())),
-                       sorted(map(str, state.get_registered_input_keys())),
-                       sorted(map(str, state.get_registered_output_keys())),
-                       {str(k): str(v) for k, v in (remapping or {}).items()}, ABSENT if doc is None else doc)
-    if not container:
+    own = _hook(state, rep, path, parent, label, is_container(state))
+    node = describe_node(state, label, path, remapping,
+                         lambda child, lbl, at, remap: _describe(child, lbl, at, rep, own, remap))
+    if not node["container"]:
         return node
-    remappings = getattr(state, "_remappings", None) or {}
-    node.update(schema.container_fields(
-        [str(s) for s in state.get_initial_states()],
-        [schema.edge(str(frm), str(outcome), None if to is None else str(to))
-         for outcome, frm, to in state.get_internal_edges()],
-        [_describe(child, str(lbl), path + "/" + str(lbl), rep, own, remappings.get(lbl, {}))
-         for lbl, child in children(state).items()]))
     if is_concurrence(state):
         default = getattr(state, "_default_outcome", None)
         node.update(default_outcome=None if default is None else str(default),

@@ -5,6 +5,7 @@ import threading
 import fsm as smach
 import pytest
 
+from fsmscope.server.testing.polling import wait_for
 from smach_support import Out, WaitForPreempt, concurrence, machine, userdata
 
 pytestmark = pytest.mark.timeout(10)
@@ -219,6 +220,8 @@ def test_shutdown_check_stops_the_concurrence_waiting_for_its_children(logs):
         assert not cc.is_running()
     finally:
         release.set()
+        # STUCK's worker then finishes it and logs that the run stopped waiting: not into the next test's lines.
+        wait_for(lambda: cc._pending == 0, 5, what="STUCK's worker to finish")
 
 
 def test_a_run_logs_smachs_debug_lines_when_it_stops_waiting_and_while_it_picks_the_mapped_outcome(logs):

@@ -15,6 +15,25 @@ from original_core import loaded_original
 from server_support import client, looping_machine
 
 
+class Bare:
+    """SMACH runs any object with a state's interface: this one has no preempt methods and takes no
+    attribute (``__slots__``); it returns 'go'."""
+
+    __slots__ = ()
+
+    def get_registered_outcomes(self):
+        return ("go",)
+
+    def get_registered_input_keys(self):
+        return ()
+
+    def get_registered_output_keys(self):
+        return ()
+
+    def execute(self, ud):
+        return "go"
+
+
 @pytest.fixture(scope="module", params=["noetic", "ros2"])
 def smach(request):
     """The original of each branch in turn, its log lines kept out of the test's output (they print otherwise)."""

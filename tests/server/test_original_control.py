@@ -11,7 +11,7 @@ from fsmscope.server.http_server import ServerThread
 from fsmscope.server.lease import Deadman
 from fsmscope.server.testing.polling import wait_for
 
-from original_control_support import (controls, holds, loop, run_in_thread, smach, status,  # noqa: F401
+from original_control_support import (Bare, controls, holds, loop, run_in_thread, smach, status,  # noqa: F401
                                       visiting, waiter, waiting)
 from server_support import client, looping_machine
 
@@ -117,21 +117,6 @@ def test_start_runs_an_original_machine_again_after_a_run_that_raised(live_serve
 
 def test_start_runs_an_original_machine_holding_a_state_with_nothing_but_execute_and_outcomes(live_server, smach):
     """SMACH runs any object with a state's interface: no preempt methods, no attributes (``__slots__``)."""
-
-    class Bare:
-        __slots__ = ()
-
-        def get_registered_outcomes(self):
-            return ("go",)
-
-        def get_registered_input_keys(self):
-            return ()
-
-        def get_registered_output_keys(self):
-            return ()
-
-        def execute(self, ud):
-            return "go"
 
     sm = smach.StateMachine(outcomes=["done"])
     with sm:

@@ -8,7 +8,7 @@ import threading
 import pytest
 from fsmscope.server.testing.polling import wait_for
 
-from original_control_support import (holds, loop, published, run_in_thread, smach,  # noqa: F401
+from original_control_support import (Bare, holds, loop, published, run_in_thread, smach,  # noqa: F401
                                       split_machine, status, visiting, waiter, waiting)
 from server_support import client, looping_machine
 
@@ -156,22 +156,11 @@ def test_a_breakpoint_in_a_container_added_to_an_original_machine_after_arming_h
     wait_for(lambda: status(http, "two")["outcome"] == "done")
 
 
-class Slotted:
-    """SMACH runs any object with a state's interface; this one takes no attribute (``__slots__``)."""
+class Slotted(Bare):
+    """SMACH runs any object with a state's interface; this one takes no attribute (``__slots__``)
+    and can be asked whether it is preempted."""
 
     __slots__ = ()
-
-    def get_registered_outcomes(self):
-        return ("go",)
-
-    def get_registered_input_keys(self):
-        return ()
-
-    def get_registered_output_keys(self):
-        return ()
-
-    def execute(self, ud):
-        return "go"
 
     def preempt_requested(self):
         return False

@@ -11,7 +11,9 @@ The comparison is what smach_ros pays per transition for its pickle, or less:
   ``==`` (the very same object: nothing to compare);
 - a value of built-in containers (dicts, lists, ... of built-in values: what ``marshal`` writes) by
   ``==`` against a copy of it made when it was last encoded, as ``marshal`` copies it (so a list
-  changed in place is seen; both sides hold built-in values only, so the comparison is C's);
+  changed in place is seen; no user code runs in making the copy, and the comparison is of built-in
+  values unless the container came to hold a user's object since: that object's ``__eq__`` may
+  then be asked once, and a comparison that raises counts as a change);
 - any other value (a user's object, a numpy array) is encoded each time.
 
 The userdata is only read, through its ``_data`` dict (read-only; reading ``ud._dirty`` or any

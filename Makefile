@@ -61,6 +61,7 @@ bench: install
 	$(PY) bench/bag_import.py
 	$(PY) bench/mcap_export.py
 	$(PY) bench/fleet_cost.py
+	$(PY) bench/original_smach.py --instructions
 	$(PY) bench/fleet_dashboard.py
 
 clean:

@@ -57,6 +57,16 @@ def enter(rep: Reporter, path: str) -> Any:
     return prev
 
 
+def enter_once(ctx: tuple[Reporter, str]) -> Any:
+    """``enter`` with the (reporter, path) made once, by whoever enters it at every step: nothing to
+    do (``NOT_ENTERED``) when it is the current one already (a child running inside its container)."""
+    prev = getattr(_context, "current", None)
+    if prev is ctx:
+        return NOT_ENTERED
+    _context.current = ctx
+    return prev
+
+
 def leave(prev: Any) -> None:
     if prev is not NOT_ENTERED:
         _context.current = prev

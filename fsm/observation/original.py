@@ -140,6 +140,8 @@ def _hook(state: Any, rep: OriginalReporter, path: str, parent: ContainerWatch |
             own = state._fsm_watch = ContainerWatch(state)
             state._report_changes = own.report_changes  # what fsm's debugger calls before a hold
         own.bind(rep, path, path == rep.root_path)
+        if getattr(state, "_debugger", None) is None:  # found at each child's step, not looked for in vain
+            state._debugger = None
     execute = state.execute
     if not isinstance(execute, Watched):
         execute = state.execute = Watched(state, execute)

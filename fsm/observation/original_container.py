@@ -47,6 +47,7 @@ class ContainerWatch:
         self.container = container
         self.rep: Any = None  # the reporter and path it reports for (set by each description)
         self.path = ""
+        self.context: tuple[Any, str] | None = None  # (rep, path): the thread's context inside it
         self.is_root = False
         self.concurrent = is_concurrence(container)
         self.userdata = UserdataWatch()
@@ -65,6 +66,7 @@ class ContainerWatch:
 
     def bind(self, rep: Any, path: str, is_root: bool) -> None:
         self.rep, self.path, self.is_root = rep, path, is_root
+        self.context = (rep, path)
 
     def _listening(self) -> Any:
         """The reporter, when it still reports this container and somebody observes it; else None."""
@@ -134,11 +136,11 @@ class ContainerWatch:
     # What the children's wrapped calls tell.
     def returned(self, label: str, outcome: Any) -> None:
         """A child returned ``outcome`` (before its container takes the transition)."""
-        with self._lock:
-            if self.concurrent:
+        if self.concurrent:
+            with self._lock:
                 self.finished.append(label)
-            else:
-                self.last = (label, None if outcome is None else str(outcome))
+        else:  # a machine's children run one at a time, in its thread
+            self.last = (label, None if outcome is None else str(outcome))
 
     def child_failed(self, label: str, exc: BaseException) -> None:
         with self._lock:
@@ -261,7 +263,7 @@ class Watched:
         parent, own, label, root = self.parent, self.own, self.label, self.root
         watch = own if own is not None else parent
         rep = watch.rep if watch is not None else None
-        prev = reporting.enter(rep, watch.path) if rep is not None else reporting.NOT_ENTERED
+        prev = reporting.enter_once(watch.context) if rep is not None else reporting.NOT_ENTERED
         try:
             if own is not None:
                 if root and rep is not None:

@@ -54,9 +54,13 @@ def watch(package: Any) -> None:
 
 
 def _wrapped(level: str, inner: Callable[..., Any]) -> Callable[..., Any]:
+    said = _QUIET_INFO_STARTS if level == "info" else None  # the lines of every step, told at once
+
     @functools.wraps(inner)
     def logged(msg: Any = "", *args: Any, **kwargs: Any) -> Any:
         result = inner(msg, *args, **kwargs)
+        if said is not None and not args and type(msg) is str and msg.startswith(said):
+            return result
         ctx = reporting.current()
         if ctx is not None:
             _send(ctx, level, msg, args)

@@ -1,12 +1,23 @@
 """A container's userdata in a machine of the original SMACH, as last reported: what changed since.
 
 The original's ``UserData`` keeps no record of writes (fsm's tracks the keys written), so a change
-is told by comparing encoded values: at a container's start every key is encoded and kept; at each
-transition and termination every key is encoded again and the keys whose encoding differs (or that
-are new) are the change. A value that is the very same immutable object as last time (a str, an int,
-...), or one of built-in types whose ``marshal`` bytes are those of last time, is not encoded again
-(``marshal`` is C, and runs no user code: what smach_ros pays per transition for its pickle). The userdata is only read, through its ``_data`` dict (read-only; reading
-``ud._dirty`` or any other missing ``_`` name of the original raises inside its ``__getattr__``).
+is told by comparing values with those last reported: at a container's start every key is encoded
+and kept; at each transition and termination each key is compared, and only the keys whose value
+differs (or that are new) are encoded again and, when their encoding differs, are the change.
+
+The comparison is what smach_ros pays per transition for its pickle, or less:
+
+- a value of an immutable built-in type (str, int, float, ...) against the last one, by type and
+  ``==`` (the very same object: nothing to compare);
+- a value of built-in containers (dicts, lists, ... of built-in values: what ``marshal`` writes) by
+  ``==`` against a copy of it made when it was last encoded, as ``marshal`` copies it (so a list
+  changed in place is seen; no user code runs in making the copy, and the comparison is of built-in
+  values unless the container came to hold a user's object since: that object's ``__eq__`` may
+  then be asked once, and a comparison that raises counts as a change);
+- any other value (a user's object, a numpy array) is encoded each time.
+
+The userdata is only read, through its ``_data`` dict (read-only; reading ``ud._dirty`` or any
+other missing ``_`` name of the original raises inside its ``__getattr__``).
 """
 
 from __future__ import annotations
@@ -16,71 +27,93 @@ from typing import Any
 
 from .encoding import _key, encode
 
-# Values whose identity says they did not change: the same object cannot have changed in place.
-_IMMUTABLE = frozenset((str, int, float, bool, type(None), bytes, complex))
+# Values compared by type and value: the same value cannot differ in place.
+_ATOMS = frozenset((str, int, float, bool, type(None), bytes, complex))
+_NO_COPY = object()  # a value with no built-in copy: encoded each time
 
 
-def _fingerprint(value: Any) -> bytes | None:
-    """The value's bytes as ``marshal`` writes them, for the built-in types it writes (dicts, lists,
-    numbers, strings, ...; no user code runs): equal bytes, an equal value, so the value need not be
-    encoded again. None for any other value (a user's object, a numpy array), which is encoded each time."""
+def _copy(value: Any) -> Any:
+    """A copy of ``value`` made of built-in values only (``marshal``'s: no user code runs), to compare
+    the value with later; ``_NO_COPY`` for a value that holds anything else."""
     try:
-        return marshal.dumps(value)
-    except (ValueError, TypeError, RecursionError):
-        return None
+        return marshal.loads(marshal.dumps(value))
+    except (ValueError, TypeError, RecursionError, EOFError):
+        return _NO_COPY
 
 
-def read(userdata: Any) -> list[tuple[Any, Any]]:
-    """The userdata's (key, value) pairs, never raising (another thread may write meanwhile)."""
+def _data(userdata: Any) -> dict:
+    """The userdata's dict of values ({} for anything without one)."""
     try:
-        data = object.__getattribute__(userdata, "_data")
+        return object.__getattribute__(userdata, "_data")
     except AttributeError:
-        return []
-    for _ in range(3):  # a child of a Concurrence may add a key while the dict is listed
-        try:
-            return list(data.items())
-        except RuntimeError:
-            continue
-    return []
+        return {}
 
 
 class UserdataWatch:
-    """The encoded values of one container's userdata, as its last event carried them."""
+    """The values of one container's userdata as its last event carried them."""
 
-    __slots__ = ("_seen",)
+    __slots__ = ("_seen", "_userdata", "_data")
 
     def __init__(self) -> None:
-        self._seen: dict[str, tuple[Any, bytes | None, Any]] | None = None  # key -> (value, fingerprint, encoding)
+        # key -> (its string, the value or its copy to compare with, the value's encoding)
+        self._seen: dict[Any, tuple[str, Any, Any]] | None = None
+        self._userdata: Any = None  # the UserData last read, and its dict (set once by the original)
+        self._data: dict = {}
+
+    def _items(self, userdata: Any) -> list[tuple[Any, Any]]:
+        """The userdata's (key, value) pairs, never raising (a Concurrence's child may add a key meanwhile)."""
+        if userdata is not self._userdata:
+            self._userdata, self._data = userdata, _data(userdata)
+        data = self._data
+        for _ in range(3):
+            try:
+                return list(data.items())
+            except RuntimeError:
+                continue
+        return []
 
     def snapshot(self, userdata: Any) -> dict:
         """Every key, encoded (a start's ``userdata``); kept to compare the next changes with."""
         seen = {}
-        for key, value in read(userdata):
-            seen[_key(key)] = (value, _fingerprint(value), encode(value))
+        for key, value in self._items(userdata):
+            seen[key] = (_key(key), _kept(value), encode(value))
         self._seen = seen
-        return {k: v[2] for k, v in seen.items()}
+        return {name: encoded for name, _, encoded in seen.values()}
 
     def changes(self, userdata: Any) -> dict:
-        """The keys whose encoded value differs from the one last reported (or that are new), encoded."""
+        """The keys whose value differs from the one last reported (or that are new), encoded."""
         seen = self._seen
         if seen is None:  # nothing reported yet in this run (observed from its middle): the baseline
             self.snapshot(userdata)
             return {}
         changed = {}
-        for key, value in read(userdata):
-            key = _key(key)
+        for key, value in self._items(userdata):
             before = seen.get(key)
-            if before is not None and before[0] is value and type(value) in _IMMUTABLE:
-                continue
-            fingerprint = _fingerprint(value)
-            if before is not None and fingerprint is not None and fingerprint == before[1]:
-                continue
+            if before is not None:
+                kept = before[1]
+                if value is kept:
+                    continue
+                if type(value) is type(kept):  # written out, not called: this runs for every key at every step
+                    try:
+                        if value == kept:
+                            continue
+                    except Exception:  # a value holding a user's object whose comparison raises
+                        pass
+                name = before[0]
+            else:
+                name = _key(key)
             encoded = encode(value)
             if before is None or before[2] != encoded:
-                changed[key] = encoded
-            seen[key] = (value, fingerprint, encoded)
+                changed[name] = encoded
+            seen[key] = (name, _kept(value), encoded)
         return changed
 
     def forget(self) -> None:
         """Nobody observes the run now starting: the next change made is compared from scratch."""
         self._seen = None
+
+
+def _kept(value: Any) -> Any:
+    """What ``value`` is compared with later: itself when immutable, else its built-in copy."""
+    return value if type(value) in _ATOMS else _copy(value)
+

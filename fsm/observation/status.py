@@ -55,6 +55,26 @@ class Status:
         run = event.get("run", self.run)
         if run != self.run:
             self.run, self.run_seq = run, event["seq"]
+        if kind == "transition" or kind == "userdata":  # first: every step of a running machine
+            entry = self.containers.get(path)
+            if entry is None:
+                entry = self.containers[path] = _container_entry()
+            if kind == "transition":
+                entry["active"] = event["active"]  # events are never changed once emitted: no copy
+                _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"],
+                                "seq": event["seq"]})
+                return
+            userdata = entry["userdata"]
+            if not entry.get("written"):
+                entry["changes"], entry["written"] = {}, True
+            changes = entry["changes"]
+            for key, new in event["changes"].items():
+                change = changes.get(key)
+                if change is None:
+                    change = changes[key] = {"old": userdata[key]} if key in userdata else {}
+                change["new"] = new
+            userdata.update(event["changes"])
+            return
         if kind == "snapshot":
             self._load(event["status"])
             return
@@ -71,7 +91,7 @@ class Status:
         if kind == "debug":
             self._debug(event)
             return
-        if kind not in ("start", "transition", "userdata", "terminate", "error"):
+        if kind not in ("start", "terminate", "error"):
             return
         entry = self.containers.get(path)
         if entry is None:
@@ -87,21 +107,6 @@ class Status:
             entry.update(active=list(event["active"]), initial=list(event["initial"]),
                          userdata=dict(event["userdata"]), running=True, outcome=None, last=None, changes={},
                          written=False)
-        elif kind == "transition":
-            entry["active"] = event["active"]  # events are never changed once emitted: no copy
-            _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"],
-                            "seq": event["seq"]})
-        elif kind == "userdata":
-            userdata = entry["userdata"]
-            if not entry.get("written"):
-                entry["changes"], entry["written"] = {}, True
-            changes = entry["changes"]
-            for key, new in event["changes"].items():
-                change = changes.get(key)
-                if change is None:
-                    change = changes[key] = {"old": userdata[key]} if key in userdata else {}
-                change["new"] = new
-            userdata.update(event["changes"])
         elif kind == "terminate":
             last = event["last"]
             state_outcome = event.get("state_outcome")

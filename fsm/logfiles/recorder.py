@@ -9,7 +9,9 @@ and fsyncs. Nothing is ever fsynced per event.
 Every ``snapshot_every`` events of a machine the recorder writes a ``snapshot`` event (the
 state rebuilt by ``fsm.observation.status.Status``) and a line ``{"machine", "seq", "t", "offset"}`` in the
 ``<path>.idx`` sidecar, so a reader can rebuild the state at any event without reading the
-log from its start (``fsm.logfiles.log_reader.seek``).
+log from its start (``fsm.logfiles.log_reader.seek``). The Status of a machine the recorder was
+attached to is its reporter's (``Reporter.folded_status``: one fold per event for every reader);
+the recorder folds one itself only for events given to it otherwise.
 
 While open, the recorder holds an exclusive ``flock`` on the log: a second recorder of it (another
 process's ``--append``) is refused with ``LogBusy`` rather than interleave two runs' seqs in one
@@ -92,6 +94,8 @@ class Recorder:
         self._buf = bytearray()
         self._index_chunks: list[bytes] = []
         self._statuses: dict[str, Status] = {}
+        self._folds: set[str] = set()  # the machines whose Status the recorder folds itself
+        self._folded: dict[str, Status] = {}  # the reporters' Statuses, until their machine's first event
         self._snapshot_at: dict[str, int] = {}  # per machine: the seq at which to write the next snapshot
         self.lines = 0  # lines handed to the writer (events and snapshots)
         self.snapshots = 0
@@ -103,8 +107,18 @@ class Recorder:
         self._writer.start()
         closing.close_at_exit(self)
 
-    # The observer call: keep it cheap (an encode, shared with the other observers, an append and
-    # one step of the reducer).
+    def attached(self, reporter: Any) -> None:
+        """``fsm.attach`` gave this recorder a machine: its snapshots are taken from the Status its
+        reporter folds (read in the reporter's ``send``, which holds that Status's lock)."""
+        folded = getattr(reporter, "folded_status", None)
+        if folded is not None:
+            status, _ = folded()
+            with self._lock:
+                if reporter.machine not in self._statuses:
+                    self._folded[reporter.machine] = status
+
+    # The observer call: keep it cheap (an encode, shared with the other observers, an append and,
+    # for a machine whose reporter does not fold its Status, one step of the reducer).
     def __call__(self, event: dict) -> None:
         data = encoding.encoded(event)
         with self._lock:
@@ -113,11 +127,13 @@ class Recorder:
             buf = self._buf
             buf += data
             buf += b"\n"
-            status = self._statuses.get(event["machine"])
+            machine = event["machine"]
+            status = self._statuses.get(machine)
             if status is None:
-                status = self._new_machine(event["machine"], event["seq"])
-            status.apply(event)
-            if status.last_seq >= self._snapshot_at[status.machine]:
+                status = self._new_machine(machine, event["seq"])
+            if machine in self._folds:
+                status.apply(event)
+            if status.last_seq >= self._snapshot_at[machine]:
                 self._snapshot(status)
             full = len(buf) >= self.flush_bytes
         if full or event["kind"] == "terminate":
@@ -129,7 +145,11 @@ class Recorder:
         return self.lines + self._buf.count(b"\n") - self.snapshots
 
     def _new_machine(self, machine: str, seq: int) -> Status:
-        status = self._statuses[machine] = Status(machine)
+        status = self._folded.pop(machine, None)
+        if status is None:
+            status = Status(machine)
+            self._folds.add(machine)
+        self._statuses[machine] = status
         self._snapshot_at[machine] = seq + self.snapshot_every
         self.machines.append(machine)
         return status

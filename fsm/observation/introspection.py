@@ -24,6 +24,7 @@ from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (
 from . import names, schema
 from .encoding import encode_userdata
 from .schema import ABSENT, MAX_DOC, build
+from .status import Status
 from .structure import children, is_container
 
 DEFAULT_ROOT_PATH = "/SM_ROOT"
@@ -57,7 +58,8 @@ def _words(exc: BaseException) -> str:
 
 
 class Reporter:
-    """Stamps one machine's events (seq, time, run) and hands them to its observers in order."""
+    """Stamps one machine's events (seq, time, run), folds them into the machine's ``Status`` when an
+    observer asked for one (``folded_status``), and hands them to its observers in order."""
 
     def __init__(self, root: Any, machine: str, root_path: str = DEFAULT_ROOT_PATH) -> None:
         self.root = root
@@ -70,10 +72,28 @@ class Reporter:
         self._owner: int | None = None  # the thread delivering an event right now
         self._described_at = -1  # the construction generation of the last structure event
         self._told: list[Observer] = []  # the observers whose failure was printed
+        self._status: Status | None = None  # folded in ``send`` once an observer asked for it
 
     @property
     def last_seq(self) -> int:
         return self._seq
+
+    def folded_status(self) -> tuple[Status, threading.Lock]:
+        """The machine's ``Status``, folded from now on once per event as it is sent, before any observer
+        sees the event, and the lock to hold to read or change it from another thread (an observer,
+        called in ``send``, holds it already). One fold for every reader that needs one (the recorder's
+        snapshots, the dashboard's page, a robot's state queries): a machine whose observers need none
+        pays nothing for it."""
+        held = self._owner == get_ident()  # asked by an observer, in ``send``: the lock is ours already
+        if not held:
+            self._lock.acquire()
+        try:
+            if self._status is None:
+                self._status = Status(self.machine)
+            return self._status, self._lock
+        finally:
+            if not held:
+                self._lock.release()
 
     def add_observer(self, observer: Observer) -> None:
         """An observer with an ``attached(reporter)`` method is then given this reporter: one that acts
@@ -107,6 +127,12 @@ class Reporter:
             self._owner = me
             self._seq = seq = self._seq + 1
             event = make(seq, _now(), self.run, self.machine, path, *args)
+            status = self._status
+            if status is not None:
+                try:
+                    status.apply(event)
+                except Exception:
+                    self._failed(status, "folding the Status")
             for observer in observers:
                 try:
                     observer(event)

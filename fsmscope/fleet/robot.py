@@ -73,7 +73,7 @@ class _Machine:
                  first: dict | None = None) -> None:
         self.name = name
         self.status = Status(name)
-        self.shared = shared  # the robot's: a host's Status read instead of this one (ZenohRobot.follow)
+        self.shared = shared  # the robot's: a Status read instead of this one (a reporter's, a host's)
         self.wake = wake  # the flusher's
         self.lock = threading.Lock()  # guards the Status (the machine's thread and Zenoh's queries)
         # The batch gathering, (seq, encoded event): the machine's thread appends without a lock (a
@@ -96,9 +96,11 @@ class _Machine:
         self.token = session.liveliness().declare_token(keys.machine_key(robot, name))  # last: all is there
 
     def keep(self, event: dict) -> None:
-        """In the machine's thread, as its observer: keep the machine's Status, then take the event."""
-        with self.lock:
-            self.status.apply(event)
+        """In the machine's thread, as its observer: keep the machine's Status (unless its reporter
+        folds it: ``ZenohRobot.attached``), then take the event."""
+        if self.name not in self.shared:
+            with self.lock:
+                self.status.apply(event)
         self.take((event["seq"], encoded(event)))
 
     def take(self, item: tuple[int, bytes]) -> None:
@@ -242,8 +244,11 @@ class ZenohRobot:
                                    if thread not in before and thread is not threading.current_thread()]
 
     def attached(self, reporter: introspection.Reporter) -> None:
-        """``fsm.attach`` gave this robot a machine: it takes the dashboards' controls from now on."""
+        """``fsm.attach`` gave this robot a machine: it takes the dashboards' controls from now on, and
+        answers state queries from the Status its reporter folds (one fold of each event for every reader)."""
         self.controls.handles.setdefault(reporter.machine, MachineHandle(reporter.root, reporter, self.can_start))
+        status, lock = reporter.folded_status()
+        self._shared.setdefault(reporter.machine, (lock, lambda: status))
 
     def take_controls(self, handle: MachineHandle) -> None:
         """Apply the controls of ``handle``'s machine through ``handle``: a host's own (one that runs the

@@ -3,16 +3,20 @@ and the sinks that take each event besides (docs/architecture.md; the loop's sid
 
 The machine's reporter calls ``Feed.observe`` in the machine's thread (through ``fanout.Observer``):
 it encodes the event once, gives it to the sinks registered (``add_sink``: the timeline index, a
-Zenoh robot publishing the machine), applies it to the Status under the feed's lock (so the Status
-is never behind the machine and never depends on the loop keeping up), and appends the encoded
-event to the bounded hand-off. When the loop does not drain fast enough and the hand-off holds
+Zenoh robot publishing the machine) and appends the encoded event to the bounded hand-off. The
+Status of a local machine is its reporter's (``fold_by``: ``Reporter.folded_status``, the one fold
+of each event that the recorder's snapshots read too), folded before the feed sees the event, under
+the reporter's lock, which is then the feed's ``lock``; a feed given events otherwise (``observe``
+alone, ``apply``) folds its own under its own. Either way the Status is never behind the machine
+and never depends on the loop keeping up. When the loop does not drain fast enough and the hand-off holds
 ``HANDOFF_LIMIT`` events, they are dropped (counted): the ring then has a gap, and every client
 behind it is sent ``missed`` and a snapshot, taken from the Status, which is always complete. The
 loop owns the ring and the clients; it reads the Status under the lock.
 
-One sink sees the Status itself, under the lock, before an event changes it: the keeper of copies
-of the Status (``keep_status``: the past's keyframes, fsmscope/server/history.py), called only at the seqs it
-asks for, so the machine pays a comparison per event for it.
+One sink sees the Status itself, under the lock, as it is before the event of a seq it asked for
+(after the event before it, for a Status the reporter folds): the keeper of copies of the Status
+(``keep_status``: the past's keyframes, fsmscope/server/history.py), so the machine pays a comparison
+per event for it.
 """
 
 from __future__ import annotations
@@ -62,7 +66,9 @@ class Feed:
 
     def __init__(self, name: str) -> None:
         self.status = Status(name)
-        self.lock = threading.Lock()  # guards the Status (applied in machine threads) and the hand-off
+        self.lock = threading.Lock()  # guards the Status (applied in machine threads); a reporter's for a local one
+        self._folds = True  # the feed folds the Status itself (False: the machine's reporter does, fold_by)
+        self._handing = threading.Lock()  # guards the hand-off
         self.handoff: collections.deque[Item] = collections.deque()  # machine thread -> loop
         self.dropped = 0  # events dropped from the hand-off since the loop last drained it
         self.queued = False  # the feed waits in the fan-out's ready queue
@@ -94,20 +100,31 @@ class Feed:
             self._keeper = keeper
             self._next_kept = 0  # the first event applied takes one of the state before it
 
+    def fold_by(self, status: Status, lock: threading.Lock) -> None:
+        """A local machine: ``status`` is the one its reporter folds (``Reporter.folded_status``) before
+        the feed sees each event, read holding ``lock``, the reporter's, which the caller holds."""
+        self.status, self.lock, self._folds = status, lock, False
+        if self._next_kept <= status.last_seq + 1:
+            self._next_kept = self._keeper(status, False)
+
     # In the machine's thread.
     def observe(self, event: dict) -> bool:
-        """Encode (once for every observer: fsm.observation.encoding.encoded), give to the sinks, apply,
-        hand over; True when the loop must be told."""
+        """Encode (once for every observer: fsm.observation.encoding.encoded), give to the sinks, apply
+        (unless the reporter did), hand over; True when the loop must be told."""
         seq = event["seq"]
         item = (seq, encoded(event))
         for sink in self._event_sinks:
             sink(event)
         for sink in self._encoded_sinks:
             sink(item)
-        with self.lock:
-            if seq >= self._next_kept:
-                self._next_kept = self._keeper(self.status, False)
-            self.status.apply(event)
+        if self._folds:
+            with self.lock:
+                if seq >= self._next_kept:
+                    self._next_kept = self._keeper(self.status, False)
+                self.status.apply(event)
+        elif seq + 1 >= self._next_kept:  # in the reporter's send, holding its lock: the Status is after seq
+            self._next_kept = self._keeper(self.status, False)
+        with self._handing:
             handoff = self.handoff
             if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
                 self.dropped += len(handoff)
@@ -121,7 +138,7 @@ class Feed:
     # On the loop.
     def take_handoff(self) -> None:
         """Move what the machine threads handed over into the ring; wake idle senders."""
-        with self.lock:
+        with self._handing:
             items, self.handoff = self.handoff, collections.deque()
             dropped, self.dropped = self.dropped, 0
             self.queued = False

@@ -159,9 +159,12 @@ class Hub:
         entry = MachineEntry(rep.machine, Origin("local", script=script), handle,
                              LogHistory(recording, rep.machine) if recording is not None else None)
         feed = entry.feed
-        feed.status.apply(schema.build.structure(rep.last_seq, time.time(), rep.run, rep.machine, rep.root_path,
-                                                 rep.structure()))
-        feed.loop_seq = rep.last_seq
+        root = rep.structure()
+        status, lock = rep.folded_status()  # one fold per event, the recorder's too
+        with lock:  # no event between: the structure takes the seq of the last one the Status holds
+            status.apply(schema.build.structure(rep.last_seq, time.time(), rep.run, rep.machine, rep.root_path, root))
+            feed.fold_by(status, lock)
+            feed.loop_seq = rep.last_seq
         entry.local = LocalMachine(rep, handle, Observer(feed, self.fanout))
         with self._lock:
             if entry.name in self._machines:

@@ -83,6 +83,21 @@ def test_a_snapshot_plus_the_events_after_it_rebuild_the_same_status(tmp_path):
     assert status.to_dict() == rebuild(plain)["m"].to_dict()
 
 
+def test_a_recorder_given_the_events_by_hand_writes_the_snapshots_of_one_attached_to_the_machine(tmp_path):
+    """The attached one reads the Status its machine's reporter folds; the other folds its own."""
+    attached = tmp_path / "attached.jsonl"
+    _, events = record(_loop(50), attached, snapshot_every=10)
+    by_hand = tmp_path / "by_hand.jsonl"
+    with Recorder(by_hand, snapshot_every=10) as recorder:
+        for event in events:
+            recorder(event)
+
+    def snapshots(path):
+        return [(e["seq"], e["status"]) for e in read_events(path) if e["kind"] == "snapshot"]
+    assert len(snapshots(attached)) >= 9
+    assert snapshots(by_hand) == snapshots(attached)
+
+
 def test_machines_recorded_from_several_threads_keep_complete_sequences(tmp_path):
     path = tmp_path / "run.jsonl"
     with Recorder(path, snapshot_every=25) as recorder:

@@ -5,6 +5,9 @@ method per kind with plain values, and the reporter encodes them, makes the even
 maker of that kind (``schema.build``) and stamps it. A machine nobody observes pays one ``is None``
 test per step: containers check their ``_reporter`` attribute, which stays None until ``attach``
 binds the tree.
+
+One piece because stamping, delivering and folding an event, and describing the tree the events
+refer to, share one reporter's lock, sequence and run.
 """
 
 from __future__ import annotations

@@ -34,6 +34,9 @@ token makes one and says it on stderr: a dashboard needs it to show the robot's 
 
 When nobody listens or the network is gone, puts go nowhere and the machine runs on; memory stays
 bounded by the batches and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
+
+One piece because the batches, the rings the queryables answer from and the machines' declarations
+are one robot's state, kept under one lock and one clock.
 """
 
 from __future__ import annotations

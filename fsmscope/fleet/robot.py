@@ -35,8 +35,8 @@ token makes one and says it on stderr: a dashboard needs it to show the robot's 
 When nobody listens or the network is gone, puts go nowhere and the machine runs on; memory stays
 bounded by the batches and the rings. Imports only the standard library, ``zenoh`` and ``fsm``.
 
-One piece because the batches, the rings the queryables answer from and the machines' declarations
-are one robot's state, kept under one lock and one clock.
+One piece because each machine's batches, the ring its queryables answer from and its declarations
+are one robot's state, put on one clock (the tick) by one flusher.
 """
 
 from __future__ import annotations

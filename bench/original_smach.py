@@ -50,6 +50,7 @@ sys.path.insert(0, str(HERE))
 import fsm  # noqa: E402
 import runtime  # noqa: E402
 from fsm.logfiles import recorder  # noqa: E402
+from fsm.observation import delivery  # noqa: E402
 from fsmscope.server import fanout  # noqa: E402
 from fsmscope.server.http_server import ServerThread  # noqa: E402
 from table import print_table, verdict  # noqa: E402
@@ -142,12 +143,13 @@ def rate(smach: Any, factory: Callable, watcher: str, server: ServerThread, runs
 def run_once(smach_name: str, workload: str, watcher: str, transitions: int) -> None:
     """What callgrind counts: the server (for fsmscope), a warm-up run of the watched machine, then a run of
     ``transitions`` (the warm-up's instructions are in the runs of ``transitions`` and of none alike).
-    The recorder's flush and the loop's drain wait ``SLOWED`` times longer, so that they take batches
-    as full as at full speed."""
+    The recorder's flush, the delivery's batches and the loop's drain wait ``SLOWED`` times longer, so
+    that they take batches as full as at full speed."""
     smach = load_original() if smach_name == "smach" else fsm
     quiet = lambda msg: None  # noqa: E731
     smach.set_loggers(quiet, quiet, quiet, quiet)
     fanout.DRAIN_INTERVAL *= SLOWED
+    delivery.INTERVAL *= SLOWED
     server = ServerThread().start() if watcher == "fsmscope" else None
     runtime.LOOP_TRANSITIONS = runtime.NESTED_STEPS = 640
     run, watch = machine_run(smach, WORKLOADS[workload], watcher, server, SLOWED)

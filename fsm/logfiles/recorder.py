@@ -1,17 +1,20 @@
 """Records events to a JSON Lines log (docs/events.md, "Log files"), cheaply enough to leave on.
 
-``Recorder(path)`` is an observer: ``fsm.attach(sm, recorder)``. Calling it encodes the
-event into an in-memory buffer; a background thread appends the buffer to the file and
-flushes it at least every ``flush_interval`` seconds (and at once when a machine
-terminates, or when ``flush_bytes`` bytes wait). ``close()`` writes what is left
-and fsyncs. Nothing is ever fsynced per event.
+``Recorder(path)`` is an observer: ``fsm.attach(sm, recorder)``. It takes a machine's events in
+batches (``take_batch``, fsm/observation/delivery.py: the events already encoded, once for every
+observer), or one at a time when called with one (``recorder(event)``), into an in-memory buffer; a
+background thread appends the buffer to the file and flushes it at least every
+``flush_interval`` seconds (and at once when a machine terminates, or when ``flush_bytes`` bytes
+wait). ``close()`` has the machines it was attached to deliver what they made, writes what is
+left and fsyncs. Nothing is ever fsynced per event.
 
 Every ``snapshot_every`` events of a machine the recorder writes a ``snapshot`` event (the
 state rebuilt by ``fsm.observation.status.Status``) and a line ``{"machine", "seq", "t", "offset"}`` in the
 ``<path>.idx`` sidecar, so a reader can rebuild the state at any event without reading the
-log from its start (``fsm.logfiles.log_reader.seek``). The Status of a machine the recorder was
-attached to is its reporter's (``Reporter.folded_status``: one fold per event for every reader);
-the recorder folds one itself only for events given to it otherwise.
+log from its start (``fsm.logfiles.log_reader.seek``); a batch ends where a snapshot is due
+(``next_cut``). The Status of a machine the recorder was attached to is its reporter's
+(``Reporter.folded_status``: one fold per event for every reader); the recorder folds one itself
+only for events given to it otherwise.
 
 While open, the recorder holds an exclusive ``flock`` on the log: a second recorder of it (another
 process's ``--append``) is refused with ``LogBusy`` rather than interleave two runs' seqs in one
@@ -33,6 +36,7 @@ from typing import Any
 
 from ..observation import closing, encoding
 from ..observation import schema
+from ..observation.delivery import Batch
 from ..observation.status import Status
 
 try:
@@ -96,6 +100,7 @@ class Recorder:
         self._statuses: dict[str, Status] = {}
         self._folds: set[str] = set()  # the machines whose Status the recorder folds itself
         self._folded: dict[str, Status] = {}  # the reporters' Statuses, until their machine's first event
+        self._reporters: list[Any] = []  # the reporters of the machines attached: they deliver before closing
         self._snapshot_at: dict[str, int] = {}  # per machine: the seq at which to write the next snapshot
         self.lines = 0  # lines handed to the writer (events and snapshots)
         self.snapshots = 0
@@ -110,15 +115,41 @@ class Recorder:
     def attached(self, reporter: Any) -> None:
         """``fsm.attach`` gave this recorder a machine: its snapshots are taken from the Status its
         reporter folds (read in the reporter's ``send``, which holds that Status's lock)."""
-        folded = getattr(reporter, "folded_status", None)
-        if folded is not None:
-            status, _ = folded()
-            with self._lock:
-                if reporter.machine not in self._statuses:
-                    self._folded[reporter.machine] = status
+        status, _ = reporter.folded_status()
+        with self._lock:
+            self._reporters.append(reporter)
+            if reporter.machine not in self._statuses:
+                self._folded[reporter.machine] = status
+                self._snapshot_at[reporter.machine] = reporter.last_seq + 1 + self.snapshot_every
 
-    # The observer call: keep it cheap (an encode, shared with the other observers, an append and,
-    # for a machine whose reporter does not fold its Status, one step of the reducer).
+    def take_batch(self, batch: Batch) -> None:
+        """A machine's events, encoded and folded (fsm/observation/delivery.py): one append for all of them."""
+        events = batch.events
+        data = batch.encoded()
+        machine = batch.machine
+        with self._lock:
+            if self._closed or self.failure is not None:
+                return
+            buf = self._buf
+            buf += b"\n".join(data)
+            buf += b"\n"
+            status = self._statuses.get(machine)
+            if status is None:
+                status = self._new_machine(machine, events[0]["seq"])
+            if machine in self._folds:
+                for event in events:
+                    status.apply(event)
+            if status.last_seq >= self._snapshot_at[machine]:
+                self._snapshot(status)
+            full = len(buf) >= self.flush_bytes
+        if full or events[-1]["kind"] == "terminate":
+            self._wake.set()
+
+    def next_cut(self, machine: str) -> int | None:
+        """The seq after which the next snapshot of ``machine`` is due: a batch ends there."""
+        return self._snapshot_at.get(machine)
+
+    # Given an event by hand (an import, a test): an encode, an append and one step of the reducer.
     def __call__(self, event: dict) -> None:
         data = encoding.encoded(event)
         with self._lock:
@@ -150,7 +181,7 @@ class Recorder:
             status = Status(machine)
             self._folds.add(machine)
         self._statuses[machine] = status
-        self._snapshot_at[machine] = seq + self.snapshot_every
+        self._snapshot_at.setdefault(machine, seq + self.snapshot_every)
         self.machines.append(machine)
         return status
 
@@ -211,6 +242,10 @@ class Recorder:
     def close(self) -> None:
         """Write what is left, fsync and close; later events are dropped. Idempotent; raises nothing
         on a failed write (``failure`` says it)."""
+        if self._closed:
+            return
+        for reporter in list(self._reporters):
+            reporter.deliver()
         with self._lock:
             if self._closed:
                 return

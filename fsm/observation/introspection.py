@@ -25,6 +25,7 @@ from typing import Any, Callable
 from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
 from . import names, schema
+from .delivery import Batch, BatchObserver, delivery
 from .encoding import encode_userdata
 from .schema import ABSENT, MAX_DOC, build
 from .status import Status
@@ -61,8 +62,11 @@ def _words(exc: BaseException) -> str:
 
 
 class Reporter:
-    """Stamps one machine's events (seq, time, run), folds them into the machine's ``Status`` when an
-    observer asked for one (``folded_status``), and hands them to its observers in order."""
+    """Stamps one machine's events (seq, time, run) and hands them to its observers in order: to each
+    plain observer at once, in the thread that made the event, and to the observers that take
+    batches (``take_batch``: the recorder, the dashboard's hub) on the delivery thread
+    (fsm/observation/delivery.py), after folding them into the machine's ``Status`` when an
+    observer asked for one (``folded_status``)."""
 
     def __init__(self, root: Any, machine: str, root_path: str = DEFAULT_ROOT_PATH) -> None:
         self.root = root
@@ -70,56 +74,79 @@ class Reporter:
         self.root_path = root_path
         self.run: str | None = None
         self._seq = 0
-        self._observers: list[Observer] = []
-        self._lock = threading.Lock()
-        self._owner: int | None = None  # the thread delivering an event right now
+        self._observers: list[Observer] = []  # called with each event, in ``send``
+        self._batched: list[BatchObserver] = []  # given each batch, in ``deliver``
+        self._pending: list[dict] | None = None  # made, not delivered yet; None: nobody takes batches or folds
+        self._lock = threading.Lock()  # guards the seq and the pending list: held for each event made
+        self._delivering = threading.RLock()  # one batch at a time; guards the Status
+        self._owner: int | None = None  # the thread calling the plain observers right now
         self._described_at = -1  # the construction generation of the last structure event
         self._told: list[Observer] = []  # the observers whose failure was printed
-        self._status: Status | None = None  # folded in ``send`` once an observer asked for it
+        self._status: Status | None = None  # folded in ``deliver`` once an observer asked for it
 
     @property
     def last_seq(self) -> int:
         return self._seq
 
-    def folded_status(self) -> tuple[Status, threading.Lock]:
-        """The machine's ``Status``, folded from now on once per event as it is sent, before any observer
-        sees the event, and the lock to hold to read or change it from another thread (an observer,
-        called in ``send``, holds it already). One fold for every reader that needs one (the recorder's
-        snapshots, the dashboard's page, a robot's state queries): a machine whose observers need none
-        pays nothing for it."""
-        held = self._owner == get_ident()  # asked by an observer, in ``send``: the lock is ours already
-        if not held:
-            self._lock.acquire()
-        try:
+    @property
+    def listening(self) -> bool:
+        """Whether an event sent now goes anywhere (an observer, or the Status folded)."""
+        return bool(self._observers) or self._pending is not None
+
+    def folded_status(self) -> tuple[Status, threading.RLock]:
+        """The machine's ``Status``, from now on folded once per event as the events are delivered,
+        before any observer that takes batches sees them, and the lock to hold to read it or change
+        it from another thread (a batch's observer holds it already). One fold for every reader that
+        needs one (the recorder's snapshots, the dashboard's page, a robot's state queries): a
+        machine whose observers need none pays nothing for it. Holding the lock, ``deliver`` brings
+        it up to the events made so far."""
+        with self._delivering:
             if self._status is None:
                 self._status = Status(self.machine)
-            return self._status, self._lock
-        finally:
-            if not held:
-                self._lock.release()
+                self._take_batches()
+            return self._status, self._delivering
 
-    def add_observer(self, observer: Observer) -> None:
-        """An observer with an ``attached(reporter)`` method is then given this reporter: one that acts
-        on the machine too (a publisher that takes controls from afar) reaches it as ``reporter.root``."""
-        # Replaced, never mutated: send iterates the list it read without the lock.
-        self._observers = self._observers + [observer]
+    def add_observer(self, observer: Observer | BatchObserver) -> None:
+        """An observer with a ``take_batch`` method is given batches (fsm/observation/delivery.py);
+        any other is called with each event. One with an ``attached(reporter)`` method is then given
+        this reporter: one that acts on the machine too (a publisher that takes controls from afar)
+        reaches it as ``reporter.root``."""
+        # Replaced, never mutated: send and deliver iterate the lists they read without the lock.
+        if callable(getattr(observer, "take_batch", None)):
+            with self._delivering:
+                self._batched = self._batched + [observer]
+                self._take_batches()
+        else:
+            self._observers = self._observers + [observer]
         self._described_at = -1  # the newcomer has not seen the structure
         _set_listening(self, True)
         attached = getattr(observer, "attached", None)
         if callable(attached):
             attached(self)
 
-    def remove_observer(self, observer: Observer) -> None:
+    def remove_observer(self, observer: Observer | BatchObserver) -> None:
+        """A batch's observer is first given what was made before (``deliver``)."""
         # Equality, not identity: ``remove_observer(events.append)`` must match the bound method given to attach.
+        if any(o == observer for o in self._batched):
+            with self._delivering:
+                self.deliver()
+                self._batched = [o for o in self._batched if o != observer]
         self._observers = [o for o in self._observers if o != observer]
-        if not self._observers:
+        if not self._observers and not self._batched:
             _set_listening(self, False)
+
+    def _take_batches(self) -> None:
+        with self._lock:
+            if self._pending is None:
+                self._pending = []
 
     def send(self, make: Callable[..., dict], path: str | None, *args: Any) -> dict | None:
         """Stamp ``make(seq, t, run, machine, path, *args)`` (a maker of ``schema.build``) and deliver it;
-        returns it (None when nobody listens)."""
+        returns it (None when nobody listens). What someone may act on as soon as it happens (a root's
+        termination, an error, a preempt, a control, the debugger's holds) is delivered before this
+        returns, with every event made before it."""
         observers = self._observers
-        if not observers:
+        if not observers and self._pending is None:
             return None
         me = get_ident()
         if self._owner == me:  # an observer logged: do not recurse into ourselves
@@ -127,24 +154,65 @@ class Reporter:
         lock = self._lock
         lock.acquire()  # not `with`: this is the hot path of every observed step
         try:
-            self._owner = me
             self._seq = seq = self._seq + 1
             event = make(seq, _now(), self.run, self.machine, path, *args)
-            status = self._status
-            if status is not None:
+            pending = self._pending
+            if pending is not None:
+                pending.append(event)
+                if len(pending) == 1:
+                    delivery.ready(self)
+            if observers:
+                self._owner = me
+                for observer in observers:
+                    try:
+                        observer(event)
+                    except Exception:
+                        self._failed(observer)
+                self._owner = None
+        finally:
+            lock.release()
+        kind = event["kind"]
+        if kind in _AT_ONCE and (kind != "terminate" or path == self.root_path) and self._pending:
+            self.deliver()
+        return event
+
+    def deliver(self) -> int:
+        """Fold the events made so far and hand them to the observers that take batches, now, in this
+        thread; returns how many. The delivery thread calls it; so does a root's termination, and an
+        observer leaving or closing, so that it is given everything made before. A batch ends at the
+        seq an observer wants the Status after (``next_cut``: the recorder's next snapshot)."""
+        with self._delivering:
+            with self._lock:
+                events = self._pending
+                if not events:
+                    return 0
+                self._pending = []
+            start, first = 0, events[0]["seq"]  # the seqs of a reporter's pending events follow each other
+            while start < len(events):
+                end = len(events)
+                for observer in self._batched:
+                    cut = observer.next_cut(self.machine) if hasattr(observer, "next_cut") else None
+                    if cut is not None and first + start <= cut < first + end - 1:
+                        end = cut - first + 1
+                self._deliver(events[start:end] if start or end < len(events) else events)
+                start = end
+            return len(events)
+
+    def _deliver(self, events: list[dict]) -> None:
+        status = self._status
+        if status is not None:
+            apply = status.apply
+            for event in events:
                 try:
-                    status.apply(event)
+                    apply(event)
                 except Exception:
                     self._failed(status, "folding the Status")
-            for observer in observers:
-                try:
-                    observer(event)
-                except Exception:
-                    self._failed(observer)
-        finally:
-            self._owner = None
-            lock.release()
-        return event
+        batch = Batch(self.machine, events, status)
+        for observer in self._batched:
+            try:
+                observer.take_batch(batch)
+            except Exception:
+                self._failed(observer)
 
     # Core's calls (fsm.core.reporting.Reporter), one per kind; those that do more than send (encode a
     # value, describe the tree, word an exception) are ``_never_raising``.
@@ -300,6 +368,9 @@ def _set_listening(rep: Reporter, on: bool) -> None:
         (_listening.add if on else _listening.discard)(rep)
         log.listener = _on_log if _listening else None
 
+
+# The kinds delivered in the thread that made them (``send``): rare, and read at once by whoever acts on them.
+_AT_ONCE = frozenset(("terminate", "error", "preempt", "control", "debug"))
 
 # The makers of the kinds core reports, bound once.
 _start, _transition, _terminate, _userdata = build.start, build.transition, build.terminate, build.userdata

@@ -71,7 +71,7 @@ class ContainerWatch:
     def _listening(self) -> Any:
         """The reporter, when it still reports this container and somebody observes it; else None."""
         rep = self.rep
-        if rep is None or not rep._observers or getattr(self.container, "_reporter", None) is not rep:
+        if rep is None or not rep.listening or getattr(self.container, "_reporter", None) is not rep:
             return None
         return rep
 
@@ -319,5 +319,5 @@ class PreemptWatched:
     def _report(self) -> None:
         state = self.state
         rep = getattr(state, "_reporter", None)
-        if rep is not None and rep._observers:
+        if rep is not None and rep.listening:
             rep.preempt(getattr(state, "_path", rep.root_path), self.phase)

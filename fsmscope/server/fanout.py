@@ -28,6 +28,7 @@ import time
 from typing import Any, Callable
 
 from fsm.observation import schema
+from fsm.observation.delivery import Batch
 from fsm.observation.encoding import dumps
 
 from .feed import Feed
@@ -109,8 +110,9 @@ class Client:
 
 
 class Observer:
-    """What a local machine's reporter calls with each event, in the machine's thread: the first hop
-    of a transition on its way to the browser (the next is ``Feed.take_handoff``, on the loop)."""
+    """What a local machine's reporter gives each batch of events, in the delivery's thread
+    (fsm/observation/delivery.py): the first hop of a transition on its way to the browser (the
+    next is ``Feed.take_handoff``, on the loop)."""
 
     __slots__ = ("feed", "fanout")
 
@@ -118,9 +120,12 @@ class Observer:
         self.feed = feed
         self.fanout = fanout
 
-    def __call__(self, event: dict) -> None:
-        if self.feed.observe(event):
+    def take_batch(self, batch: Batch) -> None:
+        if self.feed.take_batch(batch):
             self.fanout.ready(self.feed)
+
+    def next_cut(self, machine: str) -> int:
+        return self.feed.next_cut()
 
 
 class Fanout:

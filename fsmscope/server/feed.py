@@ -1,22 +1,22 @@
 """One machine's stream: its Status, the hand-off from its threads, the ring of its encoded events,
 and the sinks that take each event besides (docs/architecture.md; the loop's side is fsmscope/server/fanout.py).
 
-The machine's reporter calls ``Feed.observe`` in the machine's thread (through ``fanout.Observer``):
-it encodes the event once, gives it to the sinks registered (``add_sink``: the timeline index, a
-Zenoh robot publishing the machine) and appends the encoded event to the bounded hand-off. The
-Status of a local machine is its reporter's (``fold_by``: ``Reporter.folded_status``, the one fold
-of each event that the recorder's snapshots read too), folded before the feed sees the event, under
-the reporter's lock, which is then the feed's ``lock``; a feed given events otherwise (``observe``
-alone, ``apply``) folds its own under its own. Either way the Status is never behind the machine
-and never depends on the loop keeping up. When the loop does not drain fast enough and the hand-off holds
-``HANDOFF_LIMIT`` events, they are dropped (counted): the ring then has a gap, and every client
-behind it is sent ``missed`` and a snapshot, taken from the Status, which is always complete. The
-loop owns the ring and the clients; it reads the Status under the lock.
+A local machine's reporter gives ``Feed.take_batch`` its events in batches, on the delivery's
+thread (fsm/observation/delivery.py, through ``fanout.Observer``), encoded once for every observer
+and folded into the Status, which is the reporter's (``fold_by``: ``Reporter.folded_status``, the
+one fold that the recorder's snapshots read too), under the reporter's lock, which is then the
+feed's ``lock``. The feed gives them to the sinks registered (``add_sink``: the timeline index, a
+Zenoh robot publishing the machine) and appends them to the bounded hand-off. A feed given events
+from another process (``apply``, on the loop) folds its own Status under its own lock. Either way
+the Status is never behind what the feed was given and never depends on the loop keeping up. When
+the loop does not drain fast enough and the hand-off would hold more than ``HANDOFF_LIMIT``
+events, they are dropped (counted): the ring then has a gap, and every client behind it is sent
+``missed`` and a snapshot, taken from the Status, which is always complete. The loop owns the ring
+and the clients; it reads the Status under the lock.
 
-One sink sees the Status itself, under the lock, as it is before the event of a seq it asked for
-(after the event before it, for a Status the reporter folds): the keeper of copies of the Status
-(``keep_status``: the past's keyframes, fsmscope/server/history.py), so the machine pays a comparison
-per event for it.
+One sink sees the Status itself, under the lock: the keeper of copies of the Status
+(``keep_status``: the past's keyframes, fsmscope/server/history.py), as it is before the event of
+the seq it asked for (a local machine's batch ends there: ``next_cut``).
 """
 
 from __future__ import annotations
@@ -24,10 +24,11 @@ from __future__ import annotations
 import asyncio
 import collections
 import threading
-from typing import Callable, Protocol
+from typing import Any, Callable, Protocol
 
 from fsm.observation import schema
-from fsm.observation.encoding import dumps, encoded
+from fsm.observation.delivery import Batch
+from fsm.observation.encoding import dumps
 from fsm.observation.status import Status
 
 RING_SIZE = 20000          # recent events kept per machine for since=SEQ
@@ -66,8 +67,7 @@ class Feed:
 
     def __init__(self, name: str) -> None:
         self.status = Status(name)
-        self.lock = threading.Lock()  # guards the Status (applied in machine threads); a reporter's for a local one
-        self._folds = True  # the feed folds the Status itself (False: the machine's reporter does, fold_by)
+        self.lock: Any = threading.Lock()  # guards the Status; for a local machine its reporter's (fold_by)
         self._handing = threading.Lock()  # guards the hand-off
         self.handoff: collections.deque[Item] = collections.deque()  # machine thread -> loop
         self.dropped = 0  # events dropped from the hand-off since the loop last drained it
@@ -100,40 +100,41 @@ class Feed:
             self._keeper = keeper
             self._next_kept = 0  # the first event applied takes one of the state before it
 
-    def fold_by(self, status: Status, lock: threading.Lock) -> None:
+    def fold_by(self, status: Status, lock: Any) -> None:
         """A local machine: ``status`` is the one its reporter folds (``Reporter.folded_status``) before
-        the feed sees each event, read holding ``lock``, the reporter's, which the caller holds."""
-        self.status, self.lock, self._folds = status, lock, False
+        the feed is given each batch, read holding ``lock``, the reporter's, which the caller holds."""
+        self.status, self.lock = status, lock
         if self._next_kept <= status.last_seq + 1:
             self._next_kept = self._keeper(status, False)
 
-    # In the machine's thread.
-    def observe(self, event: dict) -> bool:
-        """Encode (once for every observer: fsm.observation.encoding.encoded), give to the sinks, apply
-        (unless the reporter did), hand over; True when the loop must be told."""
-        seq = event["seq"]
-        item = (seq, encoded(event))
+    # In the delivery's thread (fsm/observation/delivery.py), holding the lock.
+    def take_batch(self, batch: Batch) -> bool:
+        """A local machine's events, folded into the Status and encoded (once for every observer): give
+        them to the sinks, let the keeper see the Status, hand them over; True when the loop must be told."""
+        events = batch.events
+        items = list(zip([event["seq"] for event in events], batch.encoded()))
         for sink in self._event_sinks:
-            sink(event)
+            for event in events:
+                sink(event)
         for sink in self._encoded_sinks:
-            sink(item)
-        if self._folds:
-            with self.lock:
-                if seq >= self._next_kept:
-                    self._next_kept = self._keeper(self.status, False)
-                self.status.apply(event)
-        elif seq + 1 >= self._next_kept:  # in the reporter's send, holding its lock: the Status is after seq
+            for item in items:
+                sink(item)
+        if self.status.last_seq + 1 >= self._next_kept:  # the Status is after the batch's last event
             self._next_kept = self._keeper(self.status, False)
         with self._handing:
             handoff = self.handoff
-            if len(handoff) >= HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
+            if len(handoff) + len(items) > HANDOFF_LIMIT:  # the loop is not keeping up: drop, clients get a snapshot
                 self.dropped += len(handoff)
                 handoff.clear()
-            handoff.append(item)
+            handoff.extend(items)
             if self.queued:
                 return False
             self.queued = True
             return True
+
+    def next_cut(self) -> int:
+        """The seq after which the keeper wants to see the Status: a batch ends there."""
+        return self._next_kept - 1
 
     # On the loop.
     def take_handoff(self) -> None:

@@ -161,16 +161,17 @@ class Hub:
         feed = entry.feed
         root = rep.structure()
         status, lock = rep.folded_status()  # one fold per event, the recorder's too
-        with lock:  # no event between: the structure takes the seq of the last one the Status holds
+        entry.local = LocalMachine(rep, handle, Observer(feed, self.fanout))
+        with lock:  # no batch between: the Status is brought up to date, the feed takes the batches after it
+            rep.deliver()
             status.apply(schema.build.structure(rep.last_seq, time.time(), rep.run, rep.machine, rep.root_path, root))
             feed.fold_by(status, lock)
             feed.loop_seq = rep.last_seq
-        entry.local = LocalMachine(rep, handle, Observer(feed, self.fanout))
-        with self._lock:
-            if entry.name in self._machines:
-                raise ValueError("a machine named %r is already served" % entry.name)
-            self._machines[entry.name] = entry
-        rep.add_observer(entry.local.observer)
+            with self._lock:
+                if entry.name in self._machines:
+                    raise ValueError("a machine named %r is already served" % entry.name)
+                self._machines[entry.name] = entry
+            rep.add_observer(entry.local.observer)
         return entry
 
     def remove(self, name: str) -> None:

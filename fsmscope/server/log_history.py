@@ -84,7 +84,10 @@ class LogHistory:
                 status = self._scan_status
                 return (status.last_seq, status.last_t) if status.last_t is not None else None
             offset, last = self._tail
-            start = max(offset, self._marks[-1].offset if self._marks else 0)
+            marks = self._marks
+            if marks and (last is None or marks[-1].seq > last[0]):  # a log may end at a snapshot
+                last = (marks[-1].seq, marks[-1].t)
+            start = max(offset, marks[-1].offset if marks else 0)
             for _, seq, _, event in self._valid(start):
                 if event["kind"] != "snapshot":
                     last = (seq, event["t"])

@@ -77,8 +77,9 @@ class Watched:
         self.reporter: Any = None
 
     def attach(self, machine: Any) -> None:
-        self.reporter = fsm.attach(machine, self.recorder)
-        entry = self.server.hub.add_local(machine, name="bench-%d" % time.monotonic_ns())
+        # Named by the recorder's attach, as `fsmscope run`'s runner names them: the hub keeps the name.
+        self.reporter = fsm.attach(machine, self.recorder, name="bench-%d" % time.monotonic_ns())
+        entry = self.server.hub.add_local(machine)
         self.name = entry.name
         if self.robot is not None:
             robot_follows(self.robot, entry)

@@ -23,7 +23,7 @@ leaves queued at the end counts); each watched log is then read back (fsm.logfil
 
 The rounds are interleaved: round r runs every case once, in turn, so the drift of this shared
 computer's speed hits every case alike; each case is measured by its median rate over the rounds and
-each ratio is the median of the rounds' ratios. A short round first warms up, untimed.
+each ratio is the median of the rounds' ratios. A short round first warms up, not counted.
 
     .venv/bin/python bench/watched.py [--runs 7]
 """

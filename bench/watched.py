@@ -54,7 +54,7 @@ from fsmscope.server.testing.demo_process import free_endpoint  # noqa: E402
 from table import print_table, verdict  # noqa: E402
 from watchers import USERDATA, Watched, load_original, smach_ros_cost  # noqa: E402
 
-SIZES = {"LOOP_TRANSITIONS": 100_000, "NESTED_STEPS": 100_000, "CONCURRENCE_RUNS": 500}  # of bench/runtime.py, per run
+SIZES = {"LOOP_TRANSITIONS": 100_000, "NESTED_STEPS": 50_000, "CONCURRENCE_RUNS": 500}  # of bench/runtime.py, per run
 WARM_UP = 20  # the warm-up round's runs are this many times shorter
 WRITTEN_TIMEOUT = 30.0  # s a watched run's recorder is given to hold every event the machine made
 

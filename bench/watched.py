@@ -80,28 +80,30 @@ class Case:
     workload: Workload
     original: bool  # the original SMACH's machine, else fsm's
     watcher: str
-    reference: str | None = None  # the label of the case its ratio is taken to
+    reference: Case | None = None  # the case its ratio is taken to
     target: float | None = None  # the ratio it must reach
 
 
+LOOP_BARE = Case("two-state loop: original SMACH, bare", LOOP, True, BARE)
+LOOP_REFERENCE = Case("two-state loop: original SMACH + smach_ros's callback (the reference)", LOOP, True, SMACH_ROS)
+NESTED_REFERENCE = Case("3-level nested: original SMACH + smach_ros's callback on every container", NESTED, True,
+                        SMACH_ROS)
+CONCURRENCE_REFERENCE = Case("Concurrence of 4: original SMACH + smach_ros's callback", CONCURRENCE, True, SMACH_ROS)
 CASES = [
-    Case("two-state loop: original SMACH, bare", LOOP, True, BARE),
-    Case("two-state loop: original SMACH + smach_ros's callback (the reference)", LOOP, True, SMACH_ROS),
-    Case("two-state loop: fsm, bare", LOOP, False, BARE, "two-state loop: original SMACH, bare"),
-    Case("two-state loop: fsm + recorder + hub (fsmscope run)", LOOP, False, RUN,
-         "two-state loop: original SMACH + smach_ros's callback (the reference)", 1.5),
+    LOOP_BARE,
+    LOOP_REFERENCE,
+    Case("two-state loop: fsm, bare", LOOP, False, BARE, LOOP_BARE),
+    Case("two-state loop: fsm + recorder + hub (fsmscope run)", LOOP, False, RUN, LOOP_REFERENCE, 1.5),
     Case("two-state loop: fsm + recorder + hub + Zenoh robot + Foxglove (run --zenoh --foxglove)", LOOP, False,
-         RUN_FLEET, "two-state loop: original SMACH + smach_ros's callback (the reference)", 1.0),
-    Case("3-level nested: original SMACH + smach_ros's callback on every container", NESTED, True, SMACH_ROS),
-    Case("3-level nested: fsm + recorder + hub", NESTED, False, RUN,
-         "3-level nested: original SMACH + smach_ros's callback on every container", 1.5),
-    Case("Concurrence of 4: original SMACH + smach_ros's callback", CONCURRENCE, True, SMACH_ROS),
-    Case("Concurrence of 4: fsm + recorder + hub", CONCURRENCE, False, RUN,
-         "Concurrence of 4: original SMACH + smach_ros's callback", 1.5),
+         RUN_FLEET, LOOP_REFERENCE, 1.0),
+    NESTED_REFERENCE,
+    Case("3-level nested: fsm + recorder + hub", NESTED, False, RUN, NESTED_REFERENCE, 1.5),
+    CONCURRENCE_REFERENCE,
+    Case("Concurrence of 4: fsm + recorder + hub", CONCURRENCE, False, RUN, CONCURRENCE_REFERENCE, 1.5),
 ]
 
 
-class Watchers:
+class Servers:
     """What the watched cases attach to: one server for ``fsmscope run``'s watch, and one with the
     Foxglove server fed from its hub and a Zenoh robot for ``run --zenoh --foxglove``'s."""
 
@@ -139,14 +141,14 @@ def lost(watch: Watched) -> tuple[int, int, bool]:
     return made, made - len(set(seqs) & set(range(1, made + 1))), seqs != sorted(seqs)
 
 
-def run_case(case: Case, smach: Any, watchers: Watchers) -> tuple[float, tuple[int, int, bool] | None]:
+def run_case(case: Case, smach: Any, servers: Servers) -> tuple[float, tuple[int, int, bool] | None]:
     """One run of a fresh machine: its rate, and for a watched one what its log lost."""
     machine, run = case.workload.build(smach, dict(USERDATA))
     watch = None
     if case.watcher == SMACH_ROS:
         smach_ros_cost(machine)
     elif case.watcher != BARE:
-        watch = watchers.watch(case.watcher)
+        watch = servers.watch(case.watcher)
         watch.attach(machine)
     gc.collect()
     start = time.perf_counter()
@@ -167,8 +169,7 @@ def measured(case: Case, rate: float, ratio: float | None) -> str:
     text = "%s %s" % (f"{rate:,.0f}", case.workload.unit)
     if ratio is None:
         return text
-    reference = next(other for other in CASES if other.label == case.reference)
-    return "%s (%.2fx the original %s)" % (text, ratio, "bare" if reference.watcher == BARE else "watched")
+    return "%s (%.2fx the original %s)" % (text, ratio, "bare" if case.reference.watcher == BARE else "watched")
 
 
 def main() -> None:
@@ -180,7 +181,7 @@ def main() -> None:
     for smach in (original, fsm):
         smach.set_loggers(quiet, quiet, quiet, quiet)
     sys.setswitchinterval(SWITCH_INTERVAL)
-    watchers = Watchers()
+    servers = Servers()
     rates: dict[str, list[float]] = {case.label: [] for case in CASES}
     made = missing = disordered = watched_runs = 0
     try:
@@ -189,7 +190,7 @@ def main() -> None:
             for name, size in SIZES.items():
                 setattr(runtime, name, size // WARM_UP if warming else size)
             for case in CASES:
-                rate, check = run_case(case, original if case.original else fsm, watchers)
+                rate, check = run_case(case, original if case.original else fsm, servers)
                 if not warming:
                     rates[case.label].append(rate)
                 if check is not None:
@@ -198,13 +199,13 @@ def main() -> None:
             print("bench/watched.py: %s" % ("warmed up" if warming else "round %d of %d" % (round_, args.runs)),
                   file=sys.stderr, flush=True)
     finally:
-        watchers.close()
+        servers.close()
     rows = []
     for case in CASES:
         rate = statistics.median(rates[case.label])
         ratio = None
         if case.reference is not None:
-            ratio = statistics.median(r / ref for r, ref in zip(rates[case.label], rates[case.reference]))
+            ratio = statistics.median(r / ref for r, ref in zip(rates[case.label], rates[case.reference.label]))
         rows.append((case.label, "-" if case.target is None else ">= %.1fx the reference" % case.target,
                      measured(case, rate, ratio),
                      verdict(None if case.target is None else ratio >= case.target)))

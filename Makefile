@@ -62,6 +62,7 @@ bench: install
 	$(PY) bench/mcap_export.py
 	$(PY) bench/fleet_cost.py
 	$(PY) bench/original_smach.py --instructions
+	$(PY) bench/watched.py
 	$(PY) bench/fleet_dashboard.py
 
 clean:

@@ -27,15 +27,11 @@ minutes).
 from __future__ import annotations
 
 import argparse
-import base64
-import os
-import pickle
 import re
 import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 from concurrent.futures import ThreadPoolExecutor
@@ -43,75 +39,21 @@ from typing import Any, Callable
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-ORIGINAL_SRC = ROOT.parent / "shared/reference/executive_smach/noetic/smach/src"
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(HERE))
 
 import fsm  # noqa: E402
 import runtime  # noqa: E402
-from fsm.logfiles import recorder  # noqa: E402
 from fsm.observation import delivery  # noqa: E402
 from fsmscope.server import fanout  # noqa: E402
 from fsmscope.server.http_server import ServerThread  # noqa: E402
 from table import print_table, verdict  # noqa: E402
+from watchers import USERDATA, Watched, load_original, smach_ros_cost  # noqa: E402
 
-USERDATA = {"count": 0, "pose": [0.1 * i for i in range(7)], "name": "pick the red cube"}
 TRANSITIONS = 20_000  # per run, for each machine (the nested one counts steps)
 COUNTED = 10_000  # transitions of a run under callgrind
 SLOWED = 50  # callgrind runs about this many times slower: what batches by time waits as much longer
 WORKLOADS = {"two-state loop": runtime.two_state_loop, "3-level nested": runtime.nested_machine}
-
-
-def load_original() -> Any:
-    """The original smach, imported under its own name from ../shared/reference."""
-    if not (ORIGINAL_SRC / "smach" / "__init__.py").exists():
-        sys.exit("bench/original_smach.py needs the original SMACH at %s (shared/ beside the project)" % ORIGINAL_SRC)
-    sys.path.insert(0, str(ORIGINAL_SRC))
-    import smach
-    return smach
-
-
-def containers(machine: Any) -> list:
-    """The machine and every container below it."""
-    found = [machine]
-    for child in machine.get_children().values():
-        if hasattr(child, "get_children"):
-            found += containers(child)
-    return found
-
-
-def smach_ros_cost(machine: Any) -> None:
-    """smach_ros's IntrospectionServer's work in the machine's thread: its ContainerProxy registers a
-    start, transition and termination callback on every container, and each one pickles and
-    base64-encodes that container's userdata for the status message."""
-    for container in containers(machine):
-        def status(*args: Any, container: Any = container) -> None:
-            base64.b64encode(pickle.dumps(container.userdata._data, 2)).decode("utf-8")
-        container.register_start_cb(status)
-        container.register_transition_cb(status)
-        container.register_termination_cb(status)
-
-
-class Watched:
-    """fsmscope's in-process watch: the recorder and the hub of a real server, attached to a machine."""
-
-    def __init__(self, server: ServerThread, slowed: int = 1) -> None:
-        self.server = server
-        fd, self.path = tempfile.mkstemp(suffix=".jsonl")
-        os.close(fd)
-        self.recorder = fsm.Recorder(self.path, flush_interval=recorder.DEFAULT_FLUSH_INTERVAL * slowed)
-        self.name: str | None = None
-
-    def attach(self, machine: Any) -> None:
-        fsm.attach(machine, self.recorder)
-        self.name = self.server.hub.add_local(machine, name="bench-%d" % time.monotonic_ns()).name
-
-    def close(self) -> None:
-        self.server.hub.remove(self.name)
-        self.recorder.close()
-        for leftover in (self.path, self.path + ".idx"):
-            if os.path.exists(leftover):
-                os.unlink(leftover)
 
 
 def machine_run(smach: Any, factory: Callable, watcher: str, server: ServerThread | None,
@@ -145,7 +87,7 @@ def run_once(smach_name: str, workload: str, watcher: str, transitions: int) -> 
     ``transitions`` (the warm-up's instructions are in the runs of ``transitions`` and of none alike).
     The recorder's flush, the delivery's batches and the loop's drain wait ``SLOWED`` times longer, so
     that they take batches as full as at full speed."""
-    smach = load_original() if smach_name == "smach" else fsm
+    smach = load_original("bench/original_smach.py") if smach_name == "smach" else fsm
     quiet = lambda msg: None  # noqa: E731
     smach.set_loggers(quiet, quiet, quiet, quiet)
     fanout.DRAIN_INTERVAL *= SLOWED
@@ -213,7 +155,7 @@ def main() -> None:
     if args.once:
         run_once(*args.once[:3], int(args.once[3]))
         return
-    original = load_original()
+    original = load_original("bench/original_smach.py")
     runtime.LOOP_TRANSITIONS = runtime.NESTED_STEPS = TRANSITIONS
     quiet = lambda msg: None  # noqa: E731  (loggers off on both, as bench/runtime.py measures)
     for smach in (original, fsm):

@@ -106,13 +106,23 @@ def nested_machine(smach: Any = smach, userdata: dict | None = None) -> tuple:
     return root, run
 
 
-def concurrence() -> tuple:
+def concurrence(smach: Any = smach, userdata: dict | None = None) -> tuple:
+    """A Concurrence of 4 children run CONCURRENCE_RUNS times; with ``userdata`` (which must hold
+    ``count``), it starts with it and each child adds one to ``count``."""
+    def child(ud):
+        if userdata is not None:
+            ud.count += 1
+        return "ok"
+
+    keys = {"io_keys": ["count"]} if userdata is not None else {}
     cc = smach.Concurrence(outcomes=["done"], default_outcome="done")
     with cc:
         for label in "ABCD":
-            smach.Concurrence.add(label, smach.CBState(lambda ud: "ok", outcomes=["ok"]))
+            smach.Concurrence.add(label, smach.CBState(child, outcomes=["ok"], **keys))
 
     def run():
+        for key, value in (userdata or {}).items():
+            cc.userdata[key] = value
         for _ in range(CONCURRENCE_RUNS):
             cc.execute()
         return CONCURRENCE_RUNS

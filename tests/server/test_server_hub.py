@@ -5,6 +5,7 @@ import threading
 import time
 
 import fsm
+from fsm.observation import delivery
 from fsm.observation.status import Status
 
 from recording_support import two_state_loop
@@ -20,13 +21,13 @@ def has_terminate(got):
 
 def test_each_event_is_encoded_once_for_all_clients(live_server, monkeypatch):
     encoded = []
-    real = feed.encoded
+    real = delivery.dumps
 
     def counting(event):
         encoded.append(event["seq"])
         return real(event)
 
-    monkeypatch.setattr(feed, "encoded", counting)
+    monkeypatch.setattr(delivery, "dumps", counting)
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     sockets = [stream(live_server, "two") for _ in range(3)]

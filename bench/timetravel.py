@@ -104,7 +104,7 @@ def observing(events: list[dict], indexed: bool) -> Callable[[], None]:
     def observe() -> None:
         feed = Feed(MACHINE)
         if indexed:
-            feed.add_sink(TimelineIndex().add)
+            feed.add_sink(TimelineIndex().add_all)
         for start in range(0, len(events), BATCH):
             feed.take_batch(Batch(MACHINE, events[start:start + BATCH], None))
     return observe

@@ -201,12 +201,16 @@ class Reporter:
     def _deliver(self, events: list[dict]) -> None:
         status = self._status
         if status is not None:
-            apply = status.apply
-            for event in events:
-                try:
-                    apply(event)
-                except Exception:
-                    self._failed(status, "folding the Status")
+            try:
+                status.apply_all(events)
+            except Exception:  # said once; the events after the one that failed are folded one by one
+                self._failed(status, "folding the Status")
+                for event in events:
+                    if event["seq"] > status.last_seq:
+                        try:
+                            status.apply(event)
+                        except Exception:
+                            pass
         batch = Batch(self.machine, events, status)
         for observer in self._batched:
             try:

@@ -7,7 +7,7 @@ replayed run and a live one cannot disagree.
 from __future__ import annotations
 
 import copy
-from typing import Any
+from typing import Any, Sequence
 
 from .structure import containers
 
@@ -48,33 +48,46 @@ class Status:
         self.debug: dict | None = None  # the debugger's {mode, level, holds, breakpoints}, from its events
 
     def apply(self, event: dict) -> None:
-        kind = event["kind"]
-        path = event["path"]
-        self.last_seq = event["seq"]
-        self.last_t = event.get("t")
-        run = event.get("run", self.run)
-        if run != self.run:
-            self.run, self.run_seq = run, event["seq"]
-        if kind == "transition" or kind == "userdata":  # first: every step of a running machine
-            entry = self.containers.get(path)
-            if entry is None:
-                entry = self.containers[path] = _container_entry()
-            if kind == "transition":
-                entry["active"] = event["active"]  # events are never changed once emitted: no copy
-                _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"],
-                                "seq": event["seq"]})
-                return
-            userdata = entry["userdata"]
-            if not entry.get("written"):
-                entry["changes"], entry["written"] = {}, True
-            changes = entry["changes"]
-            for key, new in event["changes"].items():
-                change = changes.get(key)
-                if change is None:
-                    change = changes[key] = {"old": userdata[key]} if key in userdata else {}
-                change["new"] = new
-            userdata.update(event["changes"])
-            return
+        self.apply_all((event,))
+
+    def apply_all(self, events: Sequence[dict]) -> None:
+        """Apply events in order: a batch of them (fsm/observation/delivery.py), in one loop whose
+        every step of a running machine (a transition, its userdata) is written out here."""
+        containers = self.containers
+        run = self.run
+        for event in events:
+            kind = event["kind"]
+            path = event["path"]
+            seq = self.last_seq = event["seq"]
+            self.last_t = event.get("t")
+            if "run" in event and event["run"] != run:
+                run = self.run = event["run"]
+                self.run_seq = seq
+            if kind == "transition" or kind == "userdata":
+                entry = containers.get(path)
+                if entry is None:
+                    entry = containers[path] = _container_entry()
+                if kind == "transition":
+                    entry["active"] = event["active"]  # events are never changed once emitted: no copy
+                    _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq})
+                    continue
+                userdata = entry["userdata"]
+                if not entry.get("written"):
+                    entry["changes"], entry["written"] = {}, True
+                changes = entry["changes"]
+                for key, new in event["changes"].items():
+                    change = changes.get(key)
+                    if change is None:
+                        change = changes[key] = {"old": userdata[key]} if key in userdata else {}
+                    change["new"] = new
+                userdata.update(event["changes"])
+                continue
+            self._apply_other(event, kind, path)
+            containers, run = self.containers, self.run  # a snapshot or a structure replaces them
+
+    def _apply_other(self, event: dict, kind: str, path: str) -> None:
+        """Every kind but a step's: a run's start and end, the structure, a snapshot, a preempt, the
+        debugger, an error, the robot's pose."""
         if kind == "snapshot":
             self._load(event["status"])
             return

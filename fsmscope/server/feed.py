@@ -24,7 +24,7 @@ from __future__ import annotations
 import asyncio
 import collections
 import threading
-from typing import Any, Callable, Protocol
+from typing import Any, Callable, Protocol, Sequence
 
 from fsm.observation import schema
 from fsm.observation.delivery import Batch
@@ -36,7 +36,7 @@ HISTORY = schema.HISTORY_LIMIT  # events of the current run a new client is sent
 HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
 
 Item = tuple[int, bytes]  # an event as the ring keeps it: (seq, its JSON)
-EventSink = Callable[[dict], None]
+EventSink = Callable[[Sequence[dict]], None]
 EncodedSink = Callable[[Item], None]
 # Given the Status (holding the lock) before an event whose seq is at least the one it asked for, and
 # whether the feed starts over (a new Status): returns the seq of the next event it wants to see it before.
@@ -84,7 +84,7 @@ class Feed:
 
     # The sinks (registered before events come: the composition's, fsmscope/server/hub.py and fsmscope/server/cli/).
     def add_sink(self, sink: EventSink) -> None:
-        """``sink(event)`` with every event from now on, in order, before the Status takes it."""
+        """``sink(events)`` with every event from now on, in order: a local machine's in batches."""
         self._event_sinks += (sink,)
 
     def replace_sink(self, old: EventSink, new: EventSink) -> None:
@@ -114,8 +114,7 @@ class Feed:
         events = batch.events
         items = list(zip([event["seq"] for event in events], batch.encoded()))
         for sink in self._event_sinks:
-            for event in events:
-                sink(event)
+            sink(events)
         for sink in self._encoded_sinks:
             for item in items:
                 sink(item)
@@ -160,7 +159,7 @@ class Feed:
                 self._next_kept = self._keeper(self.status, False)
             self.status.apply(event)
         for sink in self._event_sinks:
-            sink(event)
+            sink((event,))
         item = (seq, dumps(event))
         for sink in self._encoded_sinks:
             sink(item)

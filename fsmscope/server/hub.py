@@ -63,7 +63,7 @@ class MachineEntry:
         self.origin = origin
         self.feed = Feed(name)
         self.timeline = TimelineIndex()
-        self.feed.add_sink(self.timeline.add)
+        self.feed.add_sink(self.timeline.add_all)
         self.past = History(self.feed, log)  # the ring's recent past, and a recording when it has one
         self.controls: Controls = controls if controls is not None else uncontrolled(name, origin.source)
         self.stats = StateStats(name)  # its states' statistics, counted when asked (fsmscope/server/state_stats.py)
@@ -93,7 +93,7 @@ class MachineEntry:
         over from ``status``, and so does the timeline when its seqs begin again."""
         if status.last_seq < self.feed.status.last_seq:
             timeline = TimelineIndex()
-            self.feed.replace_sink(self.timeline.add, timeline.add)
+            self.feed.replace_sink(self.timeline.add_all, timeline.add_all)
             self.timeline = timeline
         self.feed.reset(status)
         self.answers = Answers()  # seqs may begin again: no answer of the old epoch may be taken for a new one

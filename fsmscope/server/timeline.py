@@ -2,8 +2,8 @@
 (errors, preempt requests, operator controls, run starts) and the seqs to step through; what
 GET /api/machines/{name}/timeline answers (docs/api.md, "Timeline").
 
-``TimelineIndex.add`` sees every event of its machine, in the machine's thread (``Feed.observe``)
-or on the loop (``Feed.apply``), one caller at a time: only start/transition/terminate events add
+``TimelineIndex.add_all`` sees every event of its machine, in batches in the delivery's thread
+(``Feed.take_batch``) or one at a time on the loop (``Feed.apply``), one caller at a time: only start/transition/terminate events add
 a mark, error/preempt/control events a tick, the others cost a dict lookup. ``answer`` runs in
 any thread while events keep coming: storage is appended to or replaced whole, never changed in
 place, and a reader takes a list's length before reading it.
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from array import array
 from bisect import bisect_left, bisect_right
+from typing import Sequence
 
 from fsm.logfiles.transcript import debug_message
 from fsm.observation.vocabularies import EVENT_TICK_KINDS, RUN_TICK
@@ -52,7 +53,7 @@ def _bands(track: _Track, lo: float, hi: float, width: float, end: float) -> lis
     long (the marks within it), after which the last of those marks goes on; adjacent "…" merge, so
     every band but the first and last is at least ``width`` long: at most (hi - lo) / width + 2."""
     labels = track.label
-    n = len(labels)  # first: ``add`` appends to t and seq before label
+    n = len(labels)  # first: ``add_all`` appends to t and seq before label
     ts, seqs = track.t, track.seq
     stop = bisect_right(ts, hi, 0, n)
     i = max(bisect_right(ts, lo, 0, stop) - 1, 0)
@@ -96,7 +97,7 @@ def _tick_text(event: dict, kind: str) -> str | None:
 
 
 class TimelineIndex:
-    """One machine's timeline, updated with every event (``add``), answered by ``answer``."""
+    """One machine's timeline, updated with every event (``add_all``), answered by ``answer``."""
 
     def __init__(self) -> None:
         self.first: tuple[int, float] | None = None
@@ -110,45 +111,62 @@ class TimelineIndex:
         self._clock = float("-inf")  # the latest t marked: marks never go back in time (a wall clock may)
 
     def add(self, event: dict) -> None:
-        """One event of the machine, in order. A mark is the hot path (every step of a running
-        machine), written out here rather than split into calls: each call costs the machine."""
-        if self.last is None:
-            self.first = (event["seq"], event["t"])
-        self.last = event
-        kind = event["kind"]
-        if kind not in _MARKS:
-            if kind in _TICKS:
-                text = _tick_text(event, kind)
-                if text is not None:
-                    self._tick(event["seq"], self._now(event["t"]), kind, text)
-            elif kind == "structure":
-                self._check_run(event)
+        """One event of the machine, after those it was given before."""
+        self.add_all((event,))
+
+    def add_all(self, events: Sequence[dict]) -> None:
+        """Events of the machine, in order (a batch of them, fsmscope/server/feed.py). A mark is the
+        hot path (every step of a running machine), written out here rather than split into calls:
+        each call costs the machine."""
+        if not events:
             return
-        if kind == "start":
-            self._check_run(event)
-        t = event["t"]
-        if t < self._clock:
-            t = self._clock
-        else:
-            self._clock = t
-        track = self._tracks.get(event["path"])
-        if track is None:
-            track = self._tracks[event["path"]] = _Track()
-        if kind == "terminate":
-            label = None
-        else:
-            active = event["active"]
-            label = active[0] if len(active) == 1 else (SEVERAL if active else None)
-        seqs, ts = self._steps
-        seq = event["seq"]
-        seqs.append(seq)
-        ts.append(t)
-        labels = track.label
-        if not labels or labels[-1] != label:
-            track.t.append(t)
-            track.seq.append(seq)
-            labels.append(label)
-        if len(seqs) > MAX_MARKS:
+        if self.last is None:
+            self.first = (events[0]["seq"], events[0]["t"])
+        self.last = events[-1]
+        step_seqs, step_ts = self._steps
+        tracks = self._tracks
+        clock = self._clock
+        for event in events:
+            kind = event["kind"]
+            if kind not in _MARKS:
+                if kind in _TICKS:
+                    text = _tick_text(event, kind)
+                    if text is not None:
+                        self._clock = clock
+                        self._tick(event["seq"], self._now(event["t"]), kind, text)
+                        clock = self._clock
+                elif kind == "structure":
+                    self._clock = clock
+                    self._check_run(event)
+                    clock = self._clock
+                continue
+            if kind == "start":
+                self._clock = clock
+                self._check_run(event)
+                clock = self._clock
+            t = event["t"]
+            if t < clock:
+                t = clock
+            else:
+                clock = t
+            track = tracks.get(event["path"])
+            if track is None:
+                track = tracks[event["path"]] = _Track()
+            if kind == "terminate":
+                label = None
+            else:
+                active = event["active"]
+                label = active[0] if len(active) == 1 else (SEVERAL if active else None)
+            seq = event["seq"]
+            step_seqs.append(seq)
+            step_ts.append(t)
+            labels = track.label
+            if not labels or labels[-1] != label:
+                track.t.append(t)
+                track.seq.append(seq)
+                labels.append(label)
+        self._clock = clock
+        if len(step_seqs) > MAX_MARKS:
             self._coalesce()
 
     def _now(self, t: float) -> float:

@@ -10,7 +10,7 @@ import urllib.parse
 import fsm
 import pytest
 from browser_support import ACTIVE_LEAF
-from export_support import LOOPS, MARKUP, NAME, exported_run, seq_of
+from export_support import LOOPS, MARKUP, NAME, exported_run, seq_of, seq_of_write
 from recording_support import record, replay_served
 from fsm.logfiles.log_reader import seek
 from fsm.observation.schema import state_id
@@ -84,8 +84,8 @@ def rebuilt(log, seq: int) -> dict:
 
 @pytest.fixture
 def file_page(browser, run):
-    """The exported page at the root's 30th userdata event (its note changed there)."""
-    page = open_file(browser, run.html, seq_of(run.events, "userdata", "/SM_ROOT", 30))
+    """The exported page at the root's 30th write of its note (CHECK -> SUB of the 30th loop)."""
+    page = open_file(browser, run.html, seq_of_write(run.events, "/SM_ROOT", "note", 30))
     yield page
     assert not page.errors
     page.close()
@@ -93,12 +93,13 @@ def file_page(browser, run):
 
 def test_the_page_shows_the_instant_that_log_reader_seek_rebuilds(file_page, run):
     log, events = run.log, run.events
-    seq = seq_of(events, "userdata", "/SM_ROOT", 30)
+    seq = seq_of_write(events, "/SM_ROOT", "note", 30)
     page = shown(file_page)
     expected = rebuilt(log, seq)
     assert {k: page[k] for k in expected} == expected
     assert page["graph_leaf"] == state_id("/SM_ROOT/CHECK")
-    assert page["log_row"][:2] == [str(seq), "userdata"]
+    assert page["log_row"][:2] == [str(seq), "transition"]
+    assert page["log_row"][2].startswith("State machine transitioning 'CHECK':'again'-->'SUB' · Userdata: note = ")
     assert [key for key, cls, _ in page["userdata_rows"] if "changed" in cls] == ["note"]
 
 
@@ -131,7 +132,7 @@ def replay_url(run):
 
 
 def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_page, browser, replay_url, run):
-    seq = seq_of(run.events, "userdata", "/SM_ROOT", 30)
+    seq = seq_of_write(run.events, "/SM_ROOT", "note", 30)
     live = open_page(browser, replay_url + "#m=%s&seq=%d" % (urllib.parse.quote(NAME), seq))
     try:
         assert shown(at_instant(live, seq)) == shown(file_page)
@@ -142,11 +143,9 @@ def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_pag
 
 def test_next_transition_steps_into_the_nested_machine(file_page, run):
     log, events = run.log, run.events
-    to_sub = seq_of(events, "transition", "/SM_ROOT", 60)  # the root's CHECK -> SUB after the 30th note
-    into_sub = seq_of(events, "start", "/SM_ROOT/SUB", 31)  # then SUB starts its 31st run
-    for seq in (to_sub, into_sub):
-        file_page.click('#timeline button[title^="Next transition"]')
-        at_instant(file_page, seq)
+    into_sub = seq_of(events, "start", "/SM_ROOT/SUB", 31)  # after the 30th note's CHECK -> SUB, its 31st run
+    file_page.click('#timeline button[title^="Next transition"]')
+    at_instant(file_page, into_sub)
     assert shown(file_page)["active"] == rebuilt(log, into_sub)["active"] == ["/SM_ROOT/SUB", "/SM_ROOT/SUB/A"]
 
 

@@ -172,7 +172,7 @@ class Reporter:
         try:
             return encode_userdata(changes)
         except Exception:
-            self._failed(self._encoded, "observing (userdata)")
+            self._failed(encode_userdata, "observing (userdata)")  # a stable identity: said once
             return ABSENT
 
     def preempt(self, path: str, phase: str) -> None:

@@ -66,3 +66,9 @@ def exported_run(tmp_path_factory) -> ExportedRun:
 def seq_of(events, kind: str, path: str, nth: int) -> int:
     """The seq of the ``nth`` (from 1) event of ``kind`` at ``path``."""
     return [e["seq"] for e in events if e["kind"] == kind and e["path"] == path][nth - 1]
+
+
+def seq_of_write(events, path: str, key: str, nth: int) -> int:
+    """The seq of the ``nth`` (from 1) event at ``path`` that says ``key`` was written (the transition
+    or terminate of the step that wrote it)."""
+    return [e["seq"] for e in events if e["path"] == path and key in e.get("changes", {})][nth - 1]

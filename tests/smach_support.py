@@ -157,7 +157,7 @@ def one_state_machine(label: str, state: smach.State) -> smach.StateMachine:
 
 def counting_machine(rounds: int) -> smach.StateMachine:
     """SM_ROOT: COUNT (n += 1) -> SUB (A -> B, each writing `trail`) -> COUNT ..., 'done' after ``rounds``
-    (about 7 events a round: a long run of two levels with userdata, for history and recording tests)."""
+    (5 events a round: a long run of two levels with userdata, for history and recording tests)."""
     def count(ud: Any) -> str:
         ud.n = ud.n + 1
         return "again" if ud.n <= rounds else "enough"

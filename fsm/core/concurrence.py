@@ -195,9 +195,9 @@ class Concurrence(Container):
             log.info_quiet("Concurrent state '%s' returned outcome '%s' on termination." % (label, outcome))
             with self._done_cond:
                 self._child_outcomes[label] = outcome
-                if rep is not None:
-                    self._report_changes()
-                    rep.transition(self._path, str(label), str(outcome), None, self.get_active_states())
+                if rep is not None:  # the keys written since the last child's: on its transition
+                    rep.transition(self._path, str(label), str(outcome), None, self.get_active_states(),
+                                   self.userdata.take_written())
                 if self._transition_cbs:
                     self.call_transition_cbs()
                 if self._child_termination_cb:

@@ -139,6 +139,8 @@ class Container(State):
         return reporting.enter(rep, self._path)
 
     def _report_changes(self) -> None:
+        """A ``userdata`` event of the keys written since they were last reported, outside a step (a
+        debugger's hold shows them): a step's writes ride on its transition or terminate instead."""
         rep = self._reporter
         if rep is not None:
             written = self.userdata.take_written()

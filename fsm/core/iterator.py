@@ -86,8 +86,6 @@ class Iterator(Container):
             dbg = self._debugger
             if dbg is not None:
                 state_outcome = dbg.after(self, self._state_label, self._state, state_outcome)
-            if rep is not None:
-                self._report_changes()
             if self._preempt_requested:
                 self.service_preempt()
                 outcome = state_outcome
@@ -95,9 +93,9 @@ class Iterator(Container):
             if state_outcome in self._break_outcomes or (self._loop_outcomes and state_outcome not in self._loop_outcomes):
                 outcome = state_outcome
                 break
-            if rep is not None:
+            if rep is not None:  # the keys the step wrote ride on its transition (or its terminate, below)
                 rep.transition(self._path, str(self._state_label), str(state_outcome), str(self._state_label),
-                               [str(self._state_label)])
+                               [str(self._state_label)], self.userdata.take_written())
             self.call_transition_cbs()
         # As in SMACH, every ending is mapped: a break by the state's outcome, exhaustion by the exhausted outcome.
         outcome = self._final_outcome_map.get(outcome, outcome)
@@ -105,7 +103,8 @@ class Iterator(Container):
         self._is_running = False
         if rep is not None:
             rep.terminate(self._path, [str(self._state_label)], None if outcome is None else str(outcome), [],
-                          state_outcome=None if state_outcome is None else str(state_outcome))
+                          state_outcome=None if state_outcome is None else str(state_outcome),
+                          changes=self.userdata.take_written())
         self.call_termination_cbs(self._state_label, outcome)
         return outcome
 

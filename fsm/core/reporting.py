@@ -28,15 +28,19 @@ class Reporter(Protocol):
     def start(self, path: str, initial: list[str], active: list[str], userdata: Any) -> None:
         """The container at ``path`` began executing; ``userdata`` is its UserData."""
 
-    def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str]) -> None:
-        """A child of the container at ``path`` returned ``outcome``; ``to``: the next child (None in a Concurrence)."""
+    def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str],
+                   changes: dict | None = None) -> None:
+        """A child of the container at ``path`` returned ``outcome``; ``to``: the next child (None in a
+        Concurrence); ``changes``: the keys of the container's userdata the step wrote, with their values."""
 
     def terminate(self, path: str, last: list[str], outcome: str | None, active: list[str] = ...,
-                  state_outcome: str | None = ..., outcomes: dict = ..., error: str | None = ...) -> None:
-        """The container at ``path`` finished (``outcome`` None: without one)."""
+                  state_outcome: str | None = ..., outcomes: dict = ..., error: str | None = ...,
+                  changes: dict | None = None) -> None:
+        """The container at ``path`` finished (``outcome`` None: without one); ``changes`` as a transition's."""
 
     def userdata(self, path: str, written: dict) -> None:
-        """Keys of the container's userdata written since the last call, with their values."""
+        """Keys of the container's userdata written since they were last reported, with their values,
+        when no transition or terminate of the container carries them (a debugger's hold)."""
 
     def preempt(self, path: str, phase: str) -> None:
         """A preempt was 'requested' of, or 'serviced' by, the state at ``path``."""

@@ -157,14 +157,14 @@ class StateMachine(Container):
                                          % (str(outcome), str(last_state_label), str(transitions)))
         target = transitions[outcome]
         rep = self._reporter
-        if rep is not None and self.userdata._dirty:
-            self._report_changes()
 
         if target in self._states:
             self._set_current_state(target)
             log.info_quiet("State machine transitioning '%s':'%s'-->'%s'" % (last_state_label, outcome, target))
-            if rep is not None:
-                rep.transition(self._path, str(last_state_label), str(outcome), str(target), [str(target)])
+            if rep is not None:  # the keys the step wrote ride on its transition: one event per step
+                ud = self.userdata
+                rep.transition(self._path, str(last_state_label), str(outcome), str(target), [str(target)],
+                               ud.take_written() if ud._dirty else None)
             if self._transition_cbs:
                 self.call_transition_cbs()
             return None
@@ -179,9 +179,12 @@ class StateMachine(Container):
             self._set_current_state(None)
             log.info_quiet("State machine terminating '%s':'%s':'%s'" % (last_state_label, outcome, target))
             if rep is not None:
-                rep.terminate(self._path, [str(last_state_label)], str(target), [], state_outcome=str(outcome))
+                rep.terminate(self._path, [str(last_state_label)], str(target), [], state_outcome=str(outcome),
+                              changes=self.userdata.take_written())
             self.call_termination_cbs([last_state_label], target)
             return target
+        if rep is not None:
+            self._report_changes()  # the step's writes: no transition or terminate of this machine carries them
         raise InvalidTransitionError("Outcome '%s' of state '%s' with transition target '%s' is neither a registered state nor a registered container outcome."
                                      % (str(outcome), str(last_state_label), str(target)))
 

@@ -12,7 +12,7 @@ class UserData:
 
     def __init__(self) -> None:
         object.__setattr__(self, "_data", {})
-        # Keys written since the last userdata event; a set only while a reporter listens.
+        # Keys written since they were last reported (fsm/core/reporting.py); a set only while a reporter listens.
         object.__setattr__(self, "_dirty", None)
 
     def __getattr__(self, name: str) -> Any:

@@ -224,16 +224,28 @@ class Reporter:
     def start(self, path: str, initial: list[str], active: list[str], userdata: Any) -> None:
         self.send(_start, path, initial, active, encode_userdata(userdata._data))
 
-    def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str]) -> None:
-        self.send(_transition, path, from_, outcome, to, active)
+    def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str],
+                   changes: dict | None = None) -> None:
+        self.send(_transition, path, from_, outcome, to, active, self._encoded(changes) if changes else ABSENT)
 
     def terminate(self, path: str, last: list[str], outcome: str | None, active: list[str] = ABSENT,
-                  state_outcome: str | None = ABSENT, outcomes: dict = ABSENT, error: str | None = ABSENT) -> None:
-        self.send(_terminate, path, last, outcome, active, state_outcome, outcomes, error)
+                  state_outcome: str | None = ABSENT, outcomes: dict = ABSENT, error: str | None = ABSENT,
+                  changes: dict | None = None) -> None:
+        self.send(_terminate, path, last, outcome, active, state_outcome, outcomes, error,
+                  self._encoded(changes) if changes else ABSENT)
 
     @_never_raising
     def userdata(self, path: str, written: dict) -> None:
         self.send(_userdata, path, encode_userdata(written))
+
+    def _encoded(self, changes: dict) -> dict:
+        """The keys a step wrote, with their values, encoded (its event's ``changes``); what cannot be
+        encoded is said once and the event goes without them: a transition is never lost to its userdata."""
+        try:
+            return encode_userdata(changes)
+        except Exception:
+            self._failed(encode_userdata, "observing (userdata)")  # a stable identity: said once
+            return ABSENT
 
     def preempt(self, path: str, phase: str) -> None:
         self.send(_preempt, path, phase)

@@ -97,10 +97,9 @@ class ContainerWatch:
         try:
             with self._lock:
                 rep = self._listening()
-                if rep is not None:
-                    self._report_changes(rep, userdata)
+                changes = self._changes(rep, userdata)
                 if self.concurrent:
-                    self._children_returned(rep)
+                    self._children_returned(rep, changes)
                     return
                 active = _labels(active_states)
                 last, self.last = self.last, None
@@ -109,7 +108,7 @@ class ContainerWatch:
                     last = (self.active[0] if self.active else "None", self._outcome_to(to))
                 self.active = active
                 if rep is not None:
-                    rep.transition(self.path, last[0], last[1], to, active)
+                    rep.send(build.transition, self.path, last[0], last[1], to, active, changes)
         except Exception:
             self._failed("transition")
 
@@ -121,15 +120,15 @@ class ContainerWatch:
                 self.active, self.ended = [], True
                 if rep is None:
                     return
-                self._report_changes(rep, userdata)
+                changes = self._changes(rep, userdata)
                 outcome = None if outcome is None else str(outcome)
                 if self.concurrent:
-                    rep.terminate(self.path, last, outcome, [],
-                                  outcomes={label: self.outcomes.get(label) for label in self._children()})
+                    rep.send(build.terminate, self.path, last, outcome, [], ABSENT,
+                             {label: self.outcomes.get(label) for label in self._children()}, ABSENT, changes)
                     return
                 returned = self.last
                 state_outcome = ABSENT if not self.started else (returned[1] if returned is not None else None)
-                rep.terminate(self.path, last, outcome, [], state_outcome=state_outcome)
+                rep.send(build.terminate, self.path, last, outcome, [], state_outcome, ABSENT, ABSENT, changes)
         except Exception:
             self._failed("termination")
 
@@ -177,23 +176,28 @@ class ContainerWatch:
         try:
             with self._lock:
                 rep = self._listening()
-                if rep is not None:
-                    self._report_changes(rep, self.container.userdata)
+                changes = self._changes(rep, self.container.userdata)
+                if changes is not ABSENT:
+                    rep.send(build.userdata, self.path, changes)
         except Exception:
             self._failed("userdata")
 
     # Inside.
-    def _report_changes(self, rep: Any, userdata: Any) -> None:
+    def _changes(self, rep: Any, userdata: Any) -> Any:
+        """The keys changed since they were last reported, encoded: the ``changes`` of the event the
+        callback sends (ABSENT when none, or nobody listens)."""
+        if rep is None:
+            return ABSENT
         changes = self.userdata.changes(userdata)
-        if changes:
-            rep.send(build.userdata, self.path, changes)
+        return changes if changes else ABSENT
 
     def _children(self) -> list[str]:
         return [str(label) for label in self.container.get_children()]
 
-    def _children_returned(self, rep: Any) -> None:
+    def _children_returned(self, rep: Any, changes: Any) -> None:
         """A Concurrence's transition callback (at a child's start and after it returned): a
-        ``transition`` for each child whose outcome it has taken since, in the order they returned."""
+        ``transition`` for each child whose outcome it has taken since, in the order they returned,
+        the first carrying the userdata's ``changes`` (a ``userdata`` event when no child returned)."""
         taken = {str(k): v for k, v in dict(self.container._child_outcomes).items()}
         new = [label for label in self.finished if label not in self.outcomes and taken.get(label) is not None]
         new += [label for label, o in taken.items() if o is not None and label not in self.outcomes and label not in new]
@@ -203,7 +207,10 @@ class ContainerWatch:
             active = [lbl for lbl, o in taken.items() if o is None or lbl in later]
             self.active = active
             if rep is not None:
-                rep.transition(self.path, label, self.outcomes[label], None, active)
+                rep.send(build.transition, self.path, label, self.outcomes[label], None, active, changes)
+                changes = ABSENT
+        if changes is not ABSENT:
+            rep.send(build.userdata, self.path, changes)
 
     def _outcome_to(self, to: str | None) -> str:
         """The outcome of the previous active state that leads to ``to`` (its container's edges), for

@@ -17,6 +17,21 @@ def _container_entry(initial: list[str] | None = None) -> dict:
             "last": None, "changes": {}, "written": False}
 
 
+def _write(entry: dict, written: dict) -> None:
+    """Keys of the container's userdata were written (a ``userdata`` event, or the ``changes`` a
+    transition or terminate carries, applied before it): the values, and what its next transition changed."""
+    userdata = entry["userdata"]
+    if not entry.get("written"):
+        entry["changes"], entry["written"] = {}, True
+    changes = entry["changes"]
+    for key, new in written.items():
+        change = changes.get(key)
+        if change is None:
+            change = changes[key] = {"old": userdata[key]} if key in userdata else {}
+        change["new"] = new
+    userdata.update(written)
+
+
 def _settle(entry: dict, last: dict | None) -> None:
     """The container left a state: its last transition is ``last``, and the keys written since the
     previous one are what this one changed (none when nothing was written)."""
@@ -52,7 +67,8 @@ class Status:
 
     def apply_all(self, events: Sequence[dict]) -> None:
         """Apply events in order: a batch of them (fsm/observation/delivery.py), in one loop whose
-        every step of a running machine (a transition, its userdata) is written out here."""
+        every step of a running machine (a transition and the writes it carries, a userdata event)
+        is written out here."""
         containers = self.containers
         run = self.run
         for event in events:
@@ -67,20 +83,12 @@ class Status:
                 entry = containers.get(path)
                 if entry is None:
                     entry = containers[path] = _container_entry()
+                written = event.get("changes")  # a userdata event's, or those its step's transition carries
+                if written is not None:
+                    _write(entry, written)
                 if kind == "transition":
                     entry["active"] = event["active"]  # events are never changed once emitted: no copy
                     _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq})
-                    continue
-                userdata = entry["userdata"]
-                if not entry.get("written"):
-                    entry["changes"], entry["written"] = {}, True
-                changes = entry["changes"]
-                for key, new in event["changes"].items():
-                    change = changes.get(key)
-                    if change is None:
-                        change = changes[key] = {"old": userdata[key]} if key in userdata else {}
-                    change["new"] = new
-                userdata.update(event["changes"])
                 continue
             self._apply_other(event, kind, path)
             containers, run = self.containers, self.run  # a snapshot or a structure replaces them
@@ -121,6 +129,9 @@ class Status:
                          userdata=dict(event["userdata"]), running=True, outcome=None, last=None, changes={},
                          written=False)
         elif kind == "terminate":
+            written = event.get("changes")
+            if written is not None:
+                _write(entry, written)
             last = event["last"]
             state_outcome = event.get("state_outcome")
             _settle(entry, {"from": last[0], "outcome": state_outcome, "to": event["outcome"], "seq": event["seq"]}

@@ -236,10 +236,11 @@ class HistoryPage(BaseModel):
 
     model_config = ConfigDict(json_schema_extra={"examples": [{
         "events": [{"v": 1, "seq": 3, "t": 1700000000.2, "run": "3f9c2a1b7d4e", "machine": "two",
-                    "kind": "userdata", "path": "/SM_ROOT", "changes": {"visits": ["FOO"]}},
+                    "kind": "start", "path": "/SM_ROOT", "initial": ["FOO"], "active": ["FOO"],
+                    "userdata": {"visits": []}},
                    {"v": 1, "seq": 4, "t": 1700000000.25, "run": "3f9c2a1b7d4e", "machine": "two",
                     "kind": "transition", "path": "/SM_ROOT", "from": "FOO", "outcome": "go", "to": "BAR",
-                    "active": ["BAR"]}],
+                    "active": ["BAR"], "changes": {"visits": ["FOO"]}}],
         "first_seq": 1, "last_seq": 7, "more": True, "next": 5}]})
 
     events: list[dict[str, JsonValue]] = Field(description="events of docs/events.md, oldest first (no snapshots)")

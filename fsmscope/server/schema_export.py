@@ -4,7 +4,7 @@
 tables of ``docs/events.md`` and the frame tables of ``docs/api.md`` are generated from the one
 definition in ``fsm.observation.schema``; ``tests/unit/test_schema_export.py`` regenerates them and
 fails on any difference. After changing the
-schema: ``python -m server.schema_export``.
+schema: ``python -m fsmscope.server.schema_export``.
 """
 
 from __future__ import annotations
@@ -60,7 +60,7 @@ def javascript() -> str:
     """The text of fsmscope/static/schema.js."""
     escapes = {chr(code): text for code, text in schema.ID_ESCAPES.items()}
     pattern = "".join("\\u%04x" % ord(c) for c in escapes)
-    return """// Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
+    return """// Generated from fsm/observation/schema/ by `python -m fsmscope.server.schema_export`: do not edit by hand
 // (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
 // One piece because it is the page's copy of that one definition: constants, rules and typedefs.
 
@@ -156,11 +156,15 @@ def _table(fields: tuple[schema.Field, ...]) -> str:
 def tables() -> dict[str, str]:
     """Every generated table of docs/events.md, by the name its block carries."""
     out = {name: _table(kind.fields) for name, kind in schema.KINDS.items()}
-    out.update(envelope=_table(schema.ENVELOPE), node=_table(schema.NODE_FIELDS),
-               container=_table(schema.CONTAINER_FIELDS), transition=_table(schema.TRANSITION_FIELDS),
-               status=_table(schema.STATUS_FIELDS), container_status=_table(schema.CONTAINER_STATUS_FIELDS),
-               preempt=_table(schema.PREEMPT_FIELDS), debug_status=_table(schema.DEBUG_STATUS_FIELDS),
-               hold=_table(schema.HOLD_FIELDS), breakpoint=_table(schema.BREAKPOINT_FIELDS))
+    shapes = dict(envelope=_table(schema.ENVELOPE), node=_table(schema.NODE_FIELDS),
+                  container=_table(schema.CONTAINER_FIELDS), edge=_table(schema.TRANSITION_FIELDS),
+                  status=_table(schema.STATUS_FIELDS), container_status=_table(schema.CONTAINER_STATUS_FIELDS),
+                  pending_preempt=_table(schema.PREEMPT_FIELDS), debug_status=_table(schema.DEBUG_STATUS_FIELDS),
+                  hold=_table(schema.HOLD_FIELDS), breakpoint=_table(schema.BREAKPOINT_FIELDS))
+    clash = out.keys() & shapes.keys()
+    if clash:  # one block would show the other's fields
+        raise ValueError("a shape's table is named as a kind's: %s" % ", ".join(sorted(clash)))
+    out.update(shapes)
     return out
 
 

@@ -218,7 +218,7 @@ async function showKeyHistory(path, key) {
   const name = store.state.name;
   const s = shownStatus(store.state);
   try {
-    const page = await api.history(name, { since: s.run_seq, until: s.last_seq, path, kinds: "start,transition,userdata",
+    const page = await api.history(name, { since: s.run_seq, until: s.last_seq, path, kinds: "start,transition,terminate,userdata",
       limit: KEY_HISTORY_LIMIT });
     if (name === store.state.name) userdata.showHistory(key, keyHistory(page.events, key), page.more);
   } catch (err) {

@@ -1,4 +1,4 @@
-// Generated from fsm/observation/schema/ by `python -m server.schema_export`: do not edit by hand
+// Generated from fsm/observation/schema/ by `python -m fsmscope.server.schema_export`: do not edit by hand
 // (tests/unit/test_schema_export.py fails when this file and the Python definition differ).
 // One piece because it is the page's copy of that one definition: constants, rules and typedefs.
 
@@ -115,6 +115,7 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  * @property {string} outcome what it returned
  * @property {(string|null)} to the next state; null when a Concurrence child finished
  * @property {Array<string>} active the container's active states now
+ * @property {Object<string, *>} [changes] {key: encoded value}: the keys of the container's userdata its child's step wrote (as a userdata event before it would say); absent when none
  */
 
 /**
@@ -133,10 +134,11 @@ export const TICK_KINDS = Object.freeze(["error", "preempt", "control", "debug",
  * @property {(string|null)} [state_outcome] the outcome the last state returned
  * @property {Object<string, (string|null)>} [outcomes] a Concurrence's children's outcomes
  * @property {(string|null)} [error] 'ExceptionClass: message' when it failed
+ * @property {Object<string, *>} [changes] {key: encoded value}: the keys of the container's userdata its child's step wrote (as a userdata event before it would say); absent when none
  */
 
 /**
- * Keys of a container's userdata written since the last such event.
+ * Keys of a container's userdata written since the last report of them, when no transition or terminate of the container carries them.
  * @typedef {Object} UserdataEvent
  * @property {number} v schema version
  * @property {number} seq per machine, strictly increasing, never reset while the process lives

@@ -14,6 +14,22 @@ function containerEntry(initial) {
   };
 }
 
+/** Keys of the container's userdata were written (a userdata event, or the `changes` a transition or
+ * terminate carries, applied before it): the values, and what its next transition changed. */
+function write(entry, written) {
+  const userdata = entry.userdata;
+  if (!entry.written) {
+    entry.changes = {};
+    entry.written = true;
+  }
+  for (const [key, value] of Object.entries(written)) {
+    let change = entry.changes[key];
+    if (change === undefined) change = entry.changes[key] = Object.hasOwn(userdata, key) ? { old: userdata[key] } : {};
+    change.new = value;
+  }
+  Object.assign(userdata, written);
+}
+
 /** The container left a state: its last transition is `last`, and the keys written since the
  * previous one are what this one changed (none when nothing was written). */
 function settle(entry, last) {
@@ -112,21 +128,13 @@ export class Status {
         userdata: { ...event.userdata }, running: true, outcome: null, last: null, changes: {}, written: false,
       });
     } else if (kind === "transition") {
+      if (event.changes != null) write(entry, event.changes); // the keys its step wrote
       entry.active = [...event.active];
       settle(entry, { from: event.from, outcome: event.outcome, to: event.to, seq: event.seq });
     } else if (kind === "userdata") {
-      const userdata = entry.userdata;
-      if (!entry.written) {
-        entry.changes = {};
-        entry.written = true;
-      }
-      for (const [key, value] of Object.entries(event.changes)) {
-        let change = entry.changes[key];
-        if (change === undefined) change = entry.changes[key] = Object.hasOwn(userdata, key) ? { old: userdata[key] } : {};
-        change.new = value;
-      }
-      Object.assign(userdata, event.changes);
+      if (event.changes != null) write(entry, event.changes);
     } else if (kind === "terminate") {
+      if (event.changes != null) write(entry, event.changes);
       const last = event.last;
       const stateOutcome = event.state_outcome;
       settle(entry, last.length === 1 && stateOutcome

@@ -95,9 +95,11 @@ export class Transcript {
     return line ? [line] : [];
   }
 
-  /** The event log's row of the event: its SMACH line, or else a description of the event. */
+  /** The event log's row of the event: its SMACH line, or else a description of the event; a
+   * transition or terminate followed by the keys its step wrote (an older log's userdata event before it). */
   row(ev) {
-    return this.lines(ev)[0] ?? description(ev);
+    const row = this.lines(ev)[0] ?? description(ev);
+    return ev.changes && ev.kind !== "userdata" ? { level: row.level, text: row.text + " · " + writesText(ev.changes) } : row;
   }
 
   _index(ev) {
@@ -184,6 +186,11 @@ export function breakpointText(bp) {
   return text;
 }
 
+/** Written userdata keys (a userdata event's or a step's `changes`), for the event log. */
+function writesText(changes) {
+  return "Userdata: " + Object.entries(changes).map(([k, v]) => `${k} = ${valueText(v, 80)}`).join(", ");
+}
+
 /** An event that stands for no SMACH line, described for the event log. */
 function description(ev) {
   switch (ev.kind) {
@@ -195,10 +202,7 @@ function description(ev) {
       }
       break;
     case "userdata":
-      return {
-        level: "debug",
-        text: "Userdata: " + Object.entries(ev.changes || {}).map(([k, v]) => `${k} = ${valueText(v, 80)}`).join(", "),
-      };
+      return { level: "debug", text: writesText(ev.changes || {}) };
     case "preempt":
       return ev.phase === "serviced"
         ? { level: "info", text: `Preempt serviced by ${ev.path}` }

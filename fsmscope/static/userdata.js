@@ -134,8 +134,9 @@ function changeNote(change) {
   return h("span", { class: "ud-change", text, title: text });
 }
 
-/** Every change of `key` in `events` (one container's start, transition and userdata events, in
- * order): [{seq, t, state, value}], the state being the one active when it was written. */
+/** Every change of `key` in `events` (one container's start, transition, terminate and userdata
+ * events, in order): [{seq, t, state, value}], the state being the one active when it was written (a
+ * transition's or terminate's `changes` were written by the state it leaves). */
 export function keyHistory(events, key) {
   const items = [];
   let active = [];
@@ -143,11 +144,12 @@ export function keyHistory(events, key) {
     if (ev.kind === "start") {
       active = ev.active;
       if (Object.hasOwn(ev.userdata, key)) items.push({ seq: ev.seq, t: ev.t, state: "(start)", value: ev.userdata[key] });
-    } else if (ev.kind === "transition") {
-      active = ev.active;
-    } else if (ev.kind === "userdata" && Object.hasOwn(ev.changes, key)) {
+      continue;
+    }
+    if (ev.changes && Object.hasOwn(ev.changes, key)) {
       items.push({ seq: ev.seq, t: ev.t, state: active.join(", ") || "?", value: ev.changes[key] });
     }
+    if (ev.kind === "transition") active = ev.active;
   }
   return items;
 }

@@ -10,10 +10,10 @@ import urllib.parse
 import fsm
 import pytest
 from browser_support import ACTIVE_LEAF
-from export_support import LOOPS, MARKUP, NAME, exported_run, seq_of
+from export_support import LOOPS, MARKUP, NAME, exported_run, seq_of, seq_of_write
 from recording_support import record, replay_served
 from fsm.logfiles.log_reader import seek
-from fsm.observation.schema import state_id
+from fsm.observation.schema import container_id, state_id
 from fsmscope.server import export_html
 from fsmscope.server.testing.big_machine import big_machine
 from fsmscope.server.testing.browser import PAGE_WAIT_MS, open_page
@@ -68,6 +68,9 @@ SHOWN = """(() => {
 })()"""
 
 
+ACTIVE_DRAWN = "[...document.querySelectorAll('#graph g.active')].map(g => g.id).sort()"
+
+
 def shown(page) -> dict:
     """What the page shows of its instant: active states, userdata and changes, the log row marked, the userdata panel."""
     data = page.evaluate(SHOWN)
@@ -84,8 +87,8 @@ def rebuilt(log, seq: int) -> dict:
 
 @pytest.fixture
 def file_page(browser, run):
-    """The exported page at the root's 30th userdata event (its note changed there)."""
-    page = open_file(browser, run.html, seq_of(run.events, "userdata", "/SM_ROOT", 30))
+    """The exported page at the root's 30th write of its note (CHECK -> SUB of the 30th loop)."""
+    page = open_file(browser, run.html, seq_of_write(run.events, "/SM_ROOT", "note", 30))
     yield page
     assert not page.errors
     page.close()
@@ -93,12 +96,14 @@ def file_page(browser, run):
 
 def test_the_page_shows_the_instant_that_log_reader_seek_rebuilds(file_page, run):
     log, events = run.log, run.events
-    seq = seq_of(events, "userdata", "/SM_ROOT", 30)
+    seq = seq_of_write(events, "/SM_ROOT", "note", 30)
     page = shown(file_page)
     expected = rebuilt(log, seq)
     assert {k: page[k] for k in expected} == expected
-    assert page["graph_leaf"] == state_id("/SM_ROOT/CHECK")
-    assert page["log_row"][:2] == [str(seq), "userdata"]
+    # CHECK -> SUB: SUB is active and not started yet, no leaf is
+    assert file_page.evaluate(ACTIVE_DRAWN) == [container_id("/SM_ROOT"), container_id("/SM_ROOT/SUB")]
+    assert page["log_row"][:2] == [str(seq), "transition"]
+    assert page["log_row"][2].startswith("State machine transitioning 'CHECK':'again'-->'SUB' · Userdata: note = ")
     assert [key for key, cls, _ in page["userdata_rows"] if "changed" in cls] == ["note"]
 
 
@@ -131,7 +136,7 @@ def replay_url(run):
 
 
 def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_page, browser, replay_url, run):
-    seq = seq_of(run.events, "userdata", "/SM_ROOT", 30)
+    seq = seq_of_write(run.events, "/SM_ROOT", "note", 30)
     live = open_page(browser, replay_url + "#m=%s&seq=%d" % (urllib.parse.quote(NAME), seq))
     try:
         assert shown(at_instant(live, seq)) == shown(file_page)
@@ -142,11 +147,9 @@ def test_the_page_shows_what_the_live_dashboard_shows_at_the_same_event(file_pag
 
 def test_next_transition_steps_into_the_nested_machine(file_page, run):
     log, events = run.log, run.events
-    to_sub = seq_of(events, "transition", "/SM_ROOT", 60)  # the root's CHECK -> SUB after the 30th note
-    into_sub = seq_of(events, "start", "/SM_ROOT/SUB", 31)  # then SUB starts its 31st run
-    for seq in (to_sub, into_sub):
-        file_page.click('#timeline button[title^="Next transition"]')
-        at_instant(file_page, seq)
+    into_sub = seq_of(events, "start", "/SM_ROOT/SUB", 31)  # after the 30th note's CHECK -> SUB, its 31st run
+    file_page.click('#timeline button[title^="Next transition"]')
+    at_instant(file_page, into_sub)
     assert shown(file_page)["active"] == rebuilt(log, into_sub)["active"] == ["/SM_ROOT/SUB", "/SM_ROOT/SUB/A"]
 
 
@@ -170,7 +173,7 @@ def test_details_show_the_state_statistics_of_the_recording(file_page):
 @pytest.fixture(scope="module")
 def big_run(tmp_path_factory):
     """A recorded run of a machine too big to draw open (286 states: "auto" leaves its containers
-    closed), exported."""
+    closed), exported: (the page's file, the seq of a transition two containers deep in it)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     sm, stop = big_machine(branching=2, depth=3, leaves=40)
     seen = []
@@ -185,16 +188,18 @@ def big_run(tmp_path_factory):
     record(sm, log, name="big")
     html = log.with_suffix(".html")
     html.write_text(export_html.export_html(str(log)), encoding="utf-8")
-    return html
+    deep = [e["seq"] for e in seen if e["kind"] == "transition" and e["path"].count("/") == 3]
+    return html, deep[len(deep) // 2]
 
 
 def test_an_exported_big_machine_is_drawn_without_asking_for_drawings_the_file_lacks(browser, big_run):
+    html, seq = big_run
     page = browser.new_page(viewport={"width": 1280, "height": 800})
     try:
-        page.goto(big_run.as_uri() + "#m=big&seq=1500")
+        page.goto(html.as_uri() + "#m=big&seq=%d" % seq)
         page.wait_for_selector("#graph svg")
-        wait_for(lambda: page.evaluate("fsmscope.instant.seq") == 1500, 10,
-                 what=lambda: "event 1500 shown; the page is at %r" % page.evaluate("fsmscope.instant"))
+        wait_for(lambda: page.evaluate("fsmscope.instant.seq") == seq, 10,
+                 what=lambda: "event %d shown; the page is at %r" % (seq, page.evaluate("fsmscope.instant")))
         page.wait_for_timeout(1000)  # semantic zoom would have asked for the running containers by now
         assert page.evaluate("fsmscope.status.activePaths().length") > 1
         assert page.text_content("#notice") == ""

@@ -209,13 +209,14 @@ def test_playing_moves_the_instant_forward_through_the_recorded_states(browser, 
 
 
 def first_change(events, path: str, after: int) -> tuple[dict, str]:
-    """The first userdata event of container ``path`` after seq ``after`` that gives a key another value
-    (the demo's states write every output key, most with the value it had), and that key."""
+    """The first event of container ``path`` after seq ``after`` whose ``changes`` (a step's transition's
+    or terminate's) give a key another value (the demo's states write every output key, most with the
+    value it had), and that key."""
     values: dict = {}
     for e in events:
         if e["path"] == path and e["kind"] == "start":
             values = dict(e["userdata"])
-        elif e["path"] == path and e["kind"] == "userdata":
+        elif e["path"] == path and "changes" in e:
             for key, value in e["changes"].items():
                 if e["seq"] > after and (key not in values or values[key] != value):
                     return e, key
@@ -234,7 +235,7 @@ def test_the_userdata_a_transition_changed_shows_its_old_value(browser, replayed
 
 def test_a_keys_history_lists_every_change_and_jumps_to_one(browser, replayed, events):
     writes = [e["seq"] for e in events if e["path"] == "/SM_ROOT/TASK" and (
-        (e["kind"] == "userdata" and "attempts" in e["changes"]) or (e["kind"] == "start" and "attempts" in e["userdata"]))]
+        ("attempts" in e.get("changes", {})) or (e["kind"] == "start" and "attempts" in e["userdata"]))]
     page = open_at(browser, replayed[0], events[-1]["seq"])
     page.select_option("#ud-container", "/SM_ROOT/TASK")
     page.hover("#userdata tr.ud-row[data-key='attempts']")

@@ -53,10 +53,22 @@ def test_an_original_machine_attached_reports_its_run_as_an_fsm_machine_does(cor
         ("transition", "/SM_ROOT", "FOO", "outcome1", "BAR"), ("transition", "/SM_ROOT", "BAR", "outcome1", "FOO"),
         ("transition", "/SM_ROOT", "FOO", "outcome1", "BAR"), ("transition", "/SM_ROOT", "BAR", "outcome1", "FOO"),
         ("terminate", "/SM_ROOT", "outcome4")]
-    assert [e["changes"] for e in events if e["kind"] == "userdata"] == [{"counter": 1}, {"counter": 2}, {"counter": 3}]
+    assert [e["changes"] for e in events if "changes" in e] == [{"counter": 1}, {"counter": 2}, {"counter": 3}]
     assert [e["msg"] for e in events if e["kind"] == "log"] == ["counted 1", "counted 2", "counted 3"]
     status = rebuild(events)["SM_ROOT"]
     assert status.outcome == "outcome4" and status.containers["/SM_ROOT"]["userdata"] == {"counter": 3}
+
+
+def test_a_step_of_an_original_machine_that_writes_its_userdata_is_one_event_carrying_the_change(core):
+    sm = foo_bar(core)
+    events = []
+    fsm.attach(sm, events.append)
+    sm.execute()
+    steps = [(e["kind"], e.get("from", e.get("last", [None])[0]), e.get("changes")) for e in events
+             if e["kind"] in ("userdata", "transition", "terminate")]
+    assert steps == [("transition", "FOO", {"counter": 1}), ("transition", "BAR", None),
+                     ("transition", "FOO", {"counter": 2}), ("transition", "BAR", None),
+                     ("terminate", "FOO", {"counter": 3})]
 
 
 def test_the_structure_of_an_original_machine_is_read_from_its_containers(core):
@@ -142,7 +154,8 @@ def test_where_userdata_events_differ_from_fsms_a_change_is_a_value_that_differs
 
     def changes(sm, log):
         events = run(sm, scenario, tmp_path / log)["events"]
-        return [(e["kind"], e.get("from"), e.get("changes")) for e in events if e["kind"] in ("userdata", "transition")]
+        return [(e["kind"], e.get("from", e.get("last", [None])[0]), e.get("changes")) for e in events
+                if e["kind"] in ("userdata", "transition", "terminate")]
 
-    assert changes(core, "original.jsonl") == [("userdata", None, {"items": [1]}), ("transition", "APPEND", None)]
-    assert changes(fsm, "fsm.jsonl") == [("transition", "APPEND", None), ("userdata", None, {"n": 5})]
+    assert changes(core, "original.jsonl") == [("transition", "APPEND", {"items": [1]}), ("terminate", "SAME", None)]
+    assert changes(fsm, "fsm.jsonl") == [("transition", "APPEND", None), ("terminate", "SAME", {"n": 5})]

@@ -40,8 +40,8 @@ def quiet(logs):
 
 @pytest.fixture
 def recorded(live_server, tmp_path, quiet):
-    """A machine 'm' run for 400 rounds (about 3,000 events), recorded and shown: (server, http, log path)."""
-    return live_server, client(live_server), run_recorded(live_server, tmp_path, 400)
+    """A machine 'm' run for 600 rounds (about 3,000 events), recorded and shown: (server, http, log path)."""
+    return live_server, client(live_server), run_recorded(live_server, tmp_path, 600)
 
 
 def test_status_at_a_seq_equals_the_log_readers_seek(recorded):
@@ -141,7 +141,7 @@ def test_history_needs_the_token(live_server):
 
 
 def test_a_long_run_keeps_memory_bounded_and_seeks_its_beginning_in_the_recording(live_server, tmp_path, quiet):
-    rounds = 3 * feed.RING_SIZE // 7  # about 3 rings of events
+    rounds = 3 * feed.RING_SIZE // 5  # about 3 rings of events
     path = run_recorded(live_server, tmp_path, rounds)
     http = client(live_server)
     status = http.get("/api/machines/m/status", params={"seq": 5})
@@ -155,7 +155,7 @@ def test_a_long_run_keeps_memory_bounded_and_seeks_its_beginning_in_the_recordin
 
 
 def test_without_a_recording_history_reaches_back_as_far_as_the_ring(live_server, tmp_path, quiet):
-    run_recorded(live_server, tmp_path, 2 * feed.RING_SIZE // 7, recording=False)
+    run_recorded(live_server, tmp_path, 2 * feed.RING_SIZE // 5, recording=False)
     http = client(live_server)
     page = http.get("/api/machines/m/history", params={"limit": 1}).json()
     first = page["first_seq"]
@@ -166,7 +166,7 @@ def test_without_a_recording_history_reaches_back_as_far_as_the_ring(live_server
 
 
 def test_the_recent_past_from_memory_equals_the_recording(live_server, tmp_path, quiet):
-    path = run_recorded(live_server, tmp_path, 400, recording=False)
+    path = run_recorded(live_server, tmp_path, 600, recording=False)
     http = client(live_server)
     for seq in (1, 999, 1000, 1001, 2345):
         assert past(http.get("/api/machines/m/status", params={"seq": seq}).json()) == \
@@ -197,7 +197,7 @@ def test_openapi_documents_both_with_examples(live_server):
 
 
 def test_a_machine_of_another_process_answers_its_recent_past_from_memory(live_server, tmp_path, quiet):
-    path = run_recorded(live_server, tmp_path, 400, name="recorded")
+    path = run_recorded(live_server, tmp_path, 600, name="recorded")
     events = [dict(e, machine="remote") for e in read_events(path) if e["kind"] != "snapshot"]
     for event in events:
         live_server.hub.loop.call_soon_threadsafe(live_server.hub.ingest, event, "ingest")
@@ -209,7 +209,7 @@ def test_a_machine_of_another_process_answers_its_recent_past_from_memory(live_s
 
 
 def test_without_a_recording_the_timeline_says_how_far_back_an_instant_can_be_shown(live_server, tmp_path, quiet):
-    run_recorded(live_server, tmp_path, 2 * feed.RING_SIZE // 7, recording=False)
+    run_recorded(live_server, tmp_path, 2 * feed.RING_SIZE // 5, recording=False)
     http = client(live_server)
     first = http.get("/api/machines/m/history", params={"limit": 1}).json()["first_seq"]
     timeline = http.get("/api/machines/m/timeline").json()

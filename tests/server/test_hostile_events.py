@@ -45,7 +45,9 @@ def templates(machine: str) -> list[dict]:
                   ev(13, "log", machine=machine, level="warn", msg="careful"),
                   ev(14, "feedback", machine=machine, path="/SM_ROOT/A", action="move", feedback={"d": 1}),
                   ev(15, "control", machine=machine, action="preempt", client="x", result="accepted"),
-                  ev(16, "snapshot", machine=machine, status=status)]
+                  ev(16, "transition", machine=machine, changes={"k": 2},
+                     **{"from": "A", "outcome": "go", "to": "B", "active": ["B"]}),
+                  ev(17, "snapshot", machine=machine, status=status)]
 
 
 @st.composite

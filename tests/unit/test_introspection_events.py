@@ -51,17 +51,16 @@ def _nested():
     return machine(["done"], [("FOO", _writer("x", 1), {"go": "SUB"}), ("SUB", inner, {"ok": "done"})])
 
 
-def test_a_run_emits_structure_start_userdata_transition_and_terminate_in_order(observe, logs):
+def test_a_run_emits_structure_start_transition_and_terminate_in_order(observe, logs):
     sm = _nested()
     events = observe(sm)
     assert sm.execute() == "done"
-    assert _kinds(events) == [("structure", "/SM_ROOT"), ("start", "/SM_ROOT"), ("userdata", "/SM_ROOT"),
+    assert _kinds(events) == [("structure", "/SM_ROOT"), ("start", "/SM_ROOT"),
                               ("transition", "/SM_ROOT"), ("start", "/SM_ROOT/SUB"), ("terminate", "/SM_ROOT/SUB"),
                               ("terminate", "/SM_ROOT")]
     expected = [
         {"initial": ["FOO"], "active": ["FOO"], "userdata": {}},
-        {"changes": {"x": 1}},
-        {"from": "FOO", "outcome": "go", "to": "SUB", "active": ["SUB"]},
+        {"from": "FOO", "outcome": "go", "to": "SUB", "active": ["SUB"], "changes": {"x": 1}},
         {"initial": ["LEAF"], "active": ["LEAF"], "userdata": {}},
         {"last": ["LEAF"], "outcome": "ok", "active": []},
         {"last": ["SUB"], "outcome": "done", "active": []}]
@@ -169,7 +168,7 @@ def test_iterator_reports_each_looping_iteration_with_its_item_as_a_userdata_cha
     assert sm.execute() == "exhausted"
     steps = [e for e in events if e["path"] == "/SM_ROOT/IT" and e["kind"] in ("userdata", "transition")]
     step = {"from": "BODY", "outcome": "next", "to": "BODY", "active": ["BODY"]}
-    expected = [{"changes": {"it_data": 1}}, step, {"changes": {"it_data": 2}}, step]
+    expected = [dict(step, changes={"it_data": 1}), dict(step, changes={"it_data": 2})]
     assert _fields(steps, expected) == expected
 
 
@@ -345,7 +344,7 @@ def test_a_value_that_cannot_be_written_as_text_is_a_marker_and_the_run_ends_as_
     observed = machine(["done"], [("PUT", Out(_writes_a_huge_int, output_keys=["big"]), {"done": "done"})])
     events = observe(observed)
     assert observed.execute() == unobserved.execute() == "done"
-    written = next(e["changes"] for e in events if e["kind"] == "userdata")
+    written = next(e["changes"] for e in events if e["kind"] == "terminate")
     assert written == {"big": {"$repr": "<int of 16610 bits>"}}
 
 
@@ -381,5 +380,5 @@ def test_a_value_that_raises_when_looked_at_is_a_marker_and_the_run_ends_as_unob
     sm = machine(["done"], [("A", Out(writes, output_keys=["ghost"]), {"done": "done"})])
     events = observe(sm)
     assert sm.execute() == "done"
-    written = next(e["changes"] for e in events if e["kind"] == "userdata")
+    written = next(e["changes"] for e in events if e["kind"] == "terminate")
     assert written == {"ghost": {"$repr": "<unencodable Haunted: RuntimeError>"}}

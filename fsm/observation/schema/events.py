@@ -33,6 +33,10 @@ ENVELOPE = (
 )
 EVENT = Type("an event (docs/events.md)", lambda v: fields_problem(v, ENVELOPE), js="FsmEvent")
 
+# A step's writes ride on the event of the step (one event per step, not a ``userdata`` event before it).
+_STEP_CHANGES = ("{key: encoded value}: the keys of the container's userdata its child's step wrote (as a "
+                 "userdata event before it would say); absent when none")
+
 KINDS: dict[str, Kind] = {k.name: k for k in (
     Kind("structure", "The whole container tree.", (
         Field("root", NODE, doc="the root container's node; its path is the event's path"),)),
@@ -42,14 +46,17 @@ KINDS: dict[str, Kind] = {k.name: k for k in (
     Kind("transition", "The container's active states changed.", (
         Field("from", STR, doc="the state that returned"), Field("outcome", STR, doc="what it returned"),
         Field("to", OPT_STR, doc="the next state; null when a Concurrence child finished"),
-        Field("active", LIST_STR, doc="the container's active states now"))),
+        Field("active", LIST_STR, doc="the container's active states now"),
+        Field("changes", OBJECT, required=False, doc=_STEP_CHANGES))),
     Kind("terminate", "A container finished.", (
         Field("last", LIST_STR, doc="the last active state(s)"),
         Field("outcome", OPT_STR, doc="null: ended without an outcome"), Field("active", LIST_STR, required=False),
         Field("state_outcome", OPT_STR, required=False, doc="the outcome the last state returned"),
         Field("outcomes", MAP_OPT_STR, required=False, doc="a Concurrence's children's outcomes"),
-        Field("error", OPT_STR, required=False, doc="'ExceptionClass: message' when it failed"))),
-    Kind("userdata", "Keys of a container's userdata written since the last such event.", (
+        Field("error", OPT_STR, required=False, doc="'ExceptionClass: message' when it failed"),
+        Field("changes", OBJECT, required=False, doc=_STEP_CHANGES))),
+    Kind("userdata", "Keys of a container's userdata written since the last report of them, when no "
+                     "transition or terminate of the container carries them.", (
         Field("changes", OBJECT, doc="{key: encoded value}"),)),
     Kind("preempt", "A preempt was requested of, or serviced by, the state at path.", (
         Field("phase", one_of("requested", "serviced")),)),

@@ -146,10 +146,11 @@ class Reporter:
         termination, an error, a preempt, a control, the debugger's holds) is delivered before this
         returns, with every event made before it."""
         observers = self._observers
-        if not observers and self._pending is None:
-            return None
-        me = get_ident()
-        if self._owner == me:  # an observer logged: do not recurse into ourselves
+        if observers:
+            me = get_ident()
+            if self._owner == me:  # an observer logged: do not recurse into ourselves
+                return None
+        elif self._pending is None:
             return None
         lock = self._lock
         lock.acquire()  # not `with`: this is the hot path of every observed step

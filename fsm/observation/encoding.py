@@ -177,8 +177,21 @@ def encode(value: Any, cap: int | None = DEFAULT_CAP) -> Any:
     return out
 
 
+_SAFE = frozenset((str, int, float, bool, type(None)))  # types whose common values encode as they are
+
+
 def encode_userdata(data: dict, cap: int | None = DEFAULT_CAP) -> dict:
-    return {_key(k): encode(v, cap) for k, v in data.items()}
+    """``encode`` of each value under ``_key`` of its key: what a step wrote, on every observed step,
+    so the common case (a string key, a plain number, flag or short text) is tested here before a call."""
+    out = {}
+    for key, value in data.items():
+        t = type(value)
+        if t in _SAFE and (t is not int or -(2 ** 63) <= value < 2 ** 64) and (t is not float or math.isfinite(value)) \
+                and (t is not str or cap is None or len(value) <= cap):
+            out[key if type(key) is str else _key(key)] = value
+        else:
+            out[key if type(key) is str else _key(key)] = encode(value, cap)
+    return out
 
 
 if orjson is not None:

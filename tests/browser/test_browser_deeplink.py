@@ -101,7 +101,7 @@ def test_an_address_with_a_wrong_token_is_refused_and_the_link_kept(context, fin
 
 
 def test_a_hash_changed_in_the_tab_seeks_to_its_instant(context, finished):
-    first, later = seqs(finished, "m0")[1], seqs(finished, "m0")[4]
+    first, later = seqs(finished, "m0")[1], seqs(finished, "m0")[-1]
     page = opened(context, finished.url + "#m=m0&seq=%d" % first)
     shows(page, "m0", first)
     page.evaluate("(seq) => { location.hash = 'm=m0&seq=' + seq; }", later)
@@ -156,10 +156,10 @@ def test_a_seek_after_going_back_to_live_during_another_seek_is_shown(context, f
     shows(page, "m0", s[1])
     held = []
     page.route("**/api/machines/m0/status?*", lambda route: held.append(route))  # its answer does not come yet
-    page.click("#log .log-row[data-seq='%d']" % s[3])
+    page.click("#log .log-row[data-seq='%d']" % s[2])
     wait_for(lambda: held, timeout=10, what="the seek's request")
     page.click("button.tl-live")
     page.wait_for_selector("body:not(.looking-back)")
     page.unroute("**/api/machines/m0/status?*")
-    page.click("#log .log-row[data-seq='%d']" % s[4])
-    shows(page, "m0", s[4])
+    page.click("#log .log-row[data-seq='%d']" % s[3])
+    shows(page, "m0", s[3])

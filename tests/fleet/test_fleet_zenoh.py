@@ -67,7 +67,7 @@ def run_then_join() -> tuple[list[dict], Delivered]:
     endpoint = free_endpoint()
     robot = ZenohRobot("r1", listen=[endpoint], token=TOKEN)
     try:
-        own = run_on(robot, slow_loop(10, 0.0))
+        own = run_on(robot, slow_loop(40, 0.0))  # more events than a batch of the test below: one event per step
         dash = Delivered(connect=[endpoint])
         try:
             wait_for(lambda: dash.events, 10, what="the machine")

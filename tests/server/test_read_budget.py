@@ -12,6 +12,7 @@ import pytest
 from fsm.logfiles.recorder import Recorder
 
 from fsmscope.server.http_server import ServerThread
+from fsmscope.server.testing.polling import wait_for
 from fsmscope.server.read_budget import ReadBudget
 from server_support import client
 from smach_support import counting_machine
@@ -77,7 +78,8 @@ def test_a_new_event_makes_a_new_answer(tmp_path):
     with serving(tmp_path) as srv, client(srv) as http:
         before = http.get("/api/machines/m/summary").headers["etag"]
         srv.hub.get("m").local.reporter.send(fsm.observation.schema.build.log, "/SM_ROOT", "info", "one more")
-        assert http.get("/api/machines/m/summary").headers["etag"] != before
+        wait_for(lambda: http.get("/api/machines/m/summary").headers["etag"] != before,  # once delivered
+                 what="a new answer after the event")
 
 
 @pytest.mark.parametrize("url", READS)

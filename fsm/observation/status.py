@@ -76,7 +76,7 @@ class Status:
             path = event["path"]
             seq = self.last_seq = event["seq"]
             self.last_t = event.get("t")
-            if "run" in event and event["run"] != run:
+            if event.get("run", run) != run:
                 run = self.run = event["run"]
                 self.run_seq = seq
             if kind == "transition" or kind == "userdata":
@@ -86,9 +86,12 @@ class Status:
                 written = event.get("changes")  # a userdata event's, or those its step's transition carries
                 if written is not None:
                     _write(entry, written)
-                if kind == "transition":
+                if kind == "transition":  # ``_settle``, written out
+                    if not entry["written"]:
+                        entry["changes"] = {}
+                    entry["written"] = False
                     entry["active"] = event["active"]  # events are never changed once emitted: no copy
-                    _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq})
+                    entry["last"] = {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq}
                 continue
             self._apply_other(event, kind, path)
             containers, run = self.containers, self.run  # a snapshot or a structure replaces them

@@ -37,7 +37,8 @@ CLIENT_QUEUE = 4000        # events a client may lag behind before it is sent a 
 MAX_BATCH = 1000           # events per frame at most (a paced client: up to CLIENT_QUEUE)
 MAX_PACE = schema.MAX_PACE_MS / 1000  # s: the slowest pace a client may ask for
 SEND_TIMEOUT = 5.0         # a send that does not complete in this many seconds evicts the client
-DRAIN_INTERVAL = 0.02      # s after a drain during which machine threads hand over without waking the loop
+DRAIN_INTERVAL = 0.02      # s after a busy drain during which machine threads hand over without waking the loop
+BUSY_DRAIN = 64            # events taken in one drain that make it a busy one
 
 _FRAME_HEAD, _FRAME_TAIL = schema.list_frame("events")
 
@@ -169,13 +170,22 @@ class Fanout:
             self._scheduled = False
 
     def _drain(self) -> None:
-        """Take every hand-off, then keep machine threads from waking the loop for ``DRAIN_INTERVAL``: under
-        a flood the loop (and each client's sender) then runs 50 times a second rather than once per event,
-        each time taking the GIL from the machine's thread (bench/live_rewind.py)."""
+        """Take every hand-off; after a large one (a busy machine), keep machine threads from waking the
+        loop for ``DRAIN_INTERVAL``: under a flood the loop (and each client's sender) then runs 50 times
+        a second rather than once per batch, each time taking the GIL from the machine's thread
+        (bench/live_rewind.py). After a small one the next event wakes the loop at once: a machine that
+        steps now and then is seen at once (bench/server.py's latency)."""
         ready = self._ready
+        taken = 0
         while ready:
-            ready.popleft().take_handoff()
-        self.loop.call_later(DRAIN_INTERVAL, self._reopen)
+            taken += ready.popleft().take_handoff()
+        if taken >= BUSY_DRAIN:
+            self.loop.call_later(DRAIN_INTERVAL, self._reopen)
+            return
+        self._scheduled = False  # before looking: a hand-off that comes after this wakes the loop itself
+        if ready:
+            self._scheduled = True
+            self.loop.call_soon(self._drain)
 
     def _reopen(self) -> None:
         self._scheduled = False  # before looking: a hand-off that comes after this wakes the loop itself

@@ -136,20 +136,21 @@ class Feed:
         return self._next_kept - 1
 
     # On the loop.
-    def take_handoff(self) -> None:
-        """Move what the machine threads handed over into the ring; wake idle senders."""
+    def take_handoff(self) -> int:
+        """Move what the machine threads handed over into the ring; wake idle senders. Returns how many."""
         with self._handing:
             items, self.handoff = self.handoff, collections.deque()
             dropped, self.dropped = self.dropped, 0
             self.queued = False
         if not items:
-            return
+            return 0
         if dropped:  # a gap: clients whose cursor falls in it are sent missed + a snapshot
             self.ring.clear()
         self.ring.extend(items)
         self.loop_seq = items[-1][0]
         if self.idle:
             self.wake_idle()
+        return len(items)
 
     def apply(self, event: dict) -> None:
         """An event from another process: update the Status, keep the event (encoded once), wake idle senders."""

@@ -154,12 +154,31 @@ def _key(key: Any) -> str:
         return "<unrepresentable %s: %s>" % (type(key).__name__, type(exc).__name__)
 
 
+_SHORT = 32  # items of a list of plain numbers encoded without a walk: 32 x 24 characters fit any cap met
+
+
+def _plain_numbers(value: list | tuple) -> bool:
+    """A short list of finite numbers (a pose, a joint vector): its encoding is a copy of it."""
+    if len(value) > _SHORT:
+        return False
+    for x in value:
+        t = type(x)
+        if t is float:
+            if x - x != 0:  # inf or nan
+                return False
+        elif t is not int or not -(2 ** 63) <= x < 2 ** 64:
+            return False
+    return True
+
+
 def encode(value: Any, cap: int | None = DEFAULT_CAP) -> Any:
     """A JSON-safe form of ``value``; larger than ``cap`` bytes once serialised -> a marker."""
     t = type(value)
     if (value is None or t is bool or (t is int and -(2 ** 63) <= value < 2 ** 64)
             or (t is float and math.isfinite(value)) or (t is str and (cap is None or len(value) <= cap))):
         return value
+    if (t is list or t is tuple) and (cap is None or cap >= _SHORT * 24) and _plain_numbers(value):
+        return list(value)
     walk = _Walk(MAX_UNCAPPED if cap is None else cap)
     try:
         out = walk.enc(value, 0)

@@ -173,3 +173,14 @@ def test_another_event_is_encoded_for_itself_even_when_equal():
     first = encoded(event)
     copy = dict(event)
     assert encoded(copy) is not first and encoded(copy) == first
+
+
+def test_a_short_list_of_numbers_is_encoded_as_a_copy_the_machine_may_change_after():
+    pose = [0.1, 0.2, 3]
+    encoded = encode(pose)
+    pose[0] = 9.0
+    assert encoded == [0.1, 0.2, 3]
+
+
+def test_a_short_list_with_an_infinite_number_still_says_it():
+    assert encode((1.0, float("inf"), float("nan"))) == [1.0, "Infinity", "NaN"]

@@ -111,7 +111,7 @@ class UserdataWatch:
                     except Exception:  # a value holding a user's object whose comparison raises
                         pass
             new = encode(value)
-            if new != encoded:
+            if new != encoded or type(new) is not type(encoded):  # 3.0 is not 3, nor True 1, on the page
                 changed[name] = new
             seen[key] = (name, value if type(value) in _ATOMS else _copy(value), new)
         return changed

@@ -50,6 +50,12 @@ def test_values_rewritten_equal_are_no_change(watched):
     assert watch.changes(ud) == {}
 
 
+def test_an_equal_value_of_another_type_is_a_change(watched):
+    ud, watch = watched
+    ud.count, ud.ratio = 3.0, True
+    assert watch.changes(ud) == {"count": 3.0, "ratio": True}
+
+
 def test_a_container_changed_in_place_is_a_change_and_then_none(watched):
     ud, watch = watched
     ud.pose.append(0.3)

@@ -129,22 +129,27 @@ class ContainerWatch:
 
     def _on_transition(self, userdata: Any, active_states: Any, *args: Any) -> None:
         try:
-            with self._lock:
-                rep = self._listening()
-                if rep is not None:
-                    self._report_changes(rep, userdata)
-                if self.concurrent:
+            if self.concurrent:
+                with self._lock:
+                    rep = self._listening()
+                    if rep is not None:
+                        self._report_changes(rep, userdata)
                     self._children_returned(rep)
-                    return
-                active = _labels(active_states)
-                last, self.last = self.last, None
-                to = active[0] if active else None
-                if last is None:  # a child whose outcome the edges tell, or that ran before this machine was watched
-                    frm = self.active[0] if self.active else "None"
-                    last = (frm, self._outcome_to(frm, to))
-                self.active = active
-                if rep is not None:
-                    rep.transition(self.path, last[0], last[1], to, active)
+                return
+            # A StateMachine's (or an Iterator's) callbacks and its children's calls all come from
+            # its own thread: no lock taken at every step.
+            rep = self._listening()
+            if rep is not None:
+                self._report_changes(rep, userdata)
+            active = _labels(active_states)
+            last, self.last = self.last, None
+            to = active[0] if active else None
+            if last is None:  # a child whose outcome the edges tell, or that ran before this machine was watched
+                frm = self.active[0] if self.active else "None"
+                last = (frm, self._outcome_to(frm, to))
+            self.active = active
+            if rep is not None:
+                rep.transition(self.path, last[0], last[1], to, active)
         except Exception:
             self._failed("transition")
 

@@ -9,9 +9,10 @@ containers' own interface) also hooks each state that is not hooked yet, once:
 
 - every container's start, transition and termination callbacks, as smach_ros's
   IntrospectionServer registers them (original_container.ContainerWatch);
-- each state's ``execute``, where nothing else tells the outcome it returned or what it raised, a
-  container's ``request_preempt`` and every state's ``service_preempt``, each replaced on the
-  instance by a call of the same method (original_container.Watched, PreemptWatched);
+- each state's ``execute``, for what nothing else tells: the outcome it returned (unless its
+  container's edges tell it), what it raised, the debugger's gates; a container's
+  ``request_preempt`` and every state's ``service_preempt``; each replaced on the instance by a
+  call of the same method (original_container.Watched, PreemptWatched);
 - SMACH's log functions, at each run's start (original_log).
 
 A machine is described again at the start of a run whose tree differs from the one last described
@@ -93,7 +94,7 @@ class OriginalReporter(Reporter):
 
 def tree_signature(root: Any) -> tuple:
     """What a description depends on that can change after construction, cheaply: each container's
-    children, initial states and number of edges."""
+    children, initial states and edges (which of its children's outcomes its edges tell)."""
     parts = []
     stack = [root]
     while stack:
@@ -102,7 +103,7 @@ def tree_signature(root: Any) -> tuple:
             continue
         below = children(state)
         parts.append((id(state), tuple(map(id, below.values())), tuple(map(str, below)),
-                      tuple(map(str, state.get_initial_states())), len(state.get_internal_edges())))
+                      tuple(map(str, state.get_initial_states())), tuple(map(tuple, state.get_internal_edges()))))
         stack.extend(below.values())
     return tuple(parts)
 
@@ -142,10 +143,9 @@ def _hook(state: Any, rep: OriginalReporter, path: str, parent: ContainerWatch |
         own.bind(rep, path, path == rep.root_path)
         if getattr(state, "_debugger", None) is None:  # found at each child's step, not looked for in vain
             state._debugger = None
-    execute = state.execute
-    if not isinstance(execute, Watched):
-        execute = state.execute = Watched(state, execute)
-    execute.parent, execute.label, execute.own, execute.root = parent, label, own, path == rep.root_path
+    watched = Watched.of(state)
+    watched.parent, watched.label, watched.own, watched.root = parent, label, own, path == rep.root_path
+    state.execute = watched.leaf if own is None and parent is not None and label in parent.told else watched
     for name, phase in (("request_preempt", "requested"), ("service_preempt", "serviced")):
         method = getattr(state, name, None)
         if method is not None and not isinstance(method, PreemptWatched) and (container or phase == "serviced"):

@@ -7,9 +7,12 @@ IntrospectionServer uses them); not which outcome caused a transition, what a ch
 when a preempt was serviced. Those only the calls themselves tell: ``Watched`` stands for a state's
 ``execute`` (an attribute of the instance, calling the method it replaces with the same arguments
 and returning what it returns), ``PreemptWatched`` for its ``request_preempt`` or
-``service_preempt``. Nothing here changes what the machine does: every hook calls through, returns
-the same value or lets the same exception out, and what goes wrong in observing is said once on
-stderr (``Reporter._failed``).
+``service_preempt``. A leaf of a StateMachine whose outcome the container's edges tell (exactly
+one of its outcomes leads to each place it leads to: the transition or termination callback says
+the place) is called through ``Watched.leaf``, which watches only what the edges cannot tell: an
+exception, and an armed debugger's gates. Nothing here changes what the machine does: every hook
+calls through, returns the same value or lets the same exception out, and what goes wrong in
+observing is said once on stderr (``Reporter._failed``).
 
 The debugger's gates (fsm/debugging/debugger.py) are called as fsm's containers call them: before
 and after a child's ``execute``, when the container has a ``_debugger``.
@@ -29,6 +32,35 @@ from .introspection import _words
 from .original_userdata import UserdataWatch
 from .schema import ABSENT, build
 from .structure import is_concurrence
+
+
+Leads = dict[str, tuple[dict[str, "str | None"], dict[str, "str | None"]]]
+
+
+def _leads(container: Any) -> tuple[Leads, frozenset[str]]:
+    """Where each child's outcomes lead: per child, {next child: outcome} and, in a StateMachine of
+    the original, {machine's outcome: outcome} (as its ``_update_once`` takes an outcome out of the
+    machine: to the target if it is one of the machine's outcomes, else to the outcome itself), None
+    where two of its outcomes lead there; and the children of a StateMachine whose outcome these
+    tell, each place they lead to being led to by one outcome. None of either for a Concurrence."""
+    if is_concurrence(container):
+        return {}, frozenset()
+    machine = callable(getattr(container, "_update_once", None))
+    below = {str(label) for label in container.get_children()}
+    ends = {str(o) for o in container.get_registered_outcomes()}
+    leads: Leads = {}
+    for outcome, frm, to in container.get_internal_edges():
+        outcome, to = str(outcome), None if to is None else str(to)
+        to_child, to_end = leads.setdefault(str(frm), ({}, {}))
+        if to in below:
+            to_child[to] = None if to in to_child else outcome
+        elif machine:
+            end = to if to in ends else outcome
+            if end in ends:
+                to_end[end] = None if end in to_end else outcome
+    told = frozenset(label for label, (to_child, to_end) in leads.items()
+                     if machine and None not in to_child.values() and None not in to_end.values())
+    return leads, told
 
 
 def _labels(states: Any) -> list[str]:
@@ -60,6 +92,7 @@ class ContainerWatch:
         self.failure: tuple[str, BaseException] | None = None  # the first child that raised in this run
         self.finished: list[str] = []  # a Concurrence's children in the order they returned
         self.outcomes: dict[str, str | None] = {}  # a Concurrence's children's outcomes, reported
+        self.leads, self.told = _leads(container)  # where its children's outcomes lead; whose the edges tell
         container.register_start_cb(self._on_start)
         container.register_transition_cb(self._on_transition)
         container.register_termination_cb(self._on_termination)
@@ -67,6 +100,7 @@ class ContainerWatch:
     def bind(self, rep: Any, path: str, is_root: bool) -> None:
         self.rep, self.path, self.is_root = rep, path, is_root
         self.context = (rep, path)
+        self.leads, self.told = _leads(self.container)
 
     def _listening(self) -> Any:
         """The reporter, when it still reports this container and somebody observes it; else None."""
@@ -95,20 +129,24 @@ class ContainerWatch:
 
     def _on_transition(self, userdata: Any, active_states: Any, *args: Any) -> None:
         try:
-            with self._lock:
-                rep = self._listening()
-                changes = self._changes(rep, userdata)
-                if self.concurrent:
-                    self._children_returned(rep, changes)
-                    return
-                active = _labels(active_states)
-                last, self.last = self.last, None
-                to = active[0] if active else None
-                if last is None:  # the child ran before this machine was watched
-                    last = (self.active[0] if self.active else "None", self._outcome_to(to))
-                self.active = active
-                if rep is not None:
-                    rep.send(build.transition, self.path, last[0], last[1], to, active, changes)
+            if self.concurrent:
+                with self._lock:
+                    rep = self._listening()
+                    self._children_returned(rep, self._changes(rep, userdata))
+                return
+            # A StateMachine's (or an Iterator's) callbacks and its children's calls all come from
+            # its own thread: no lock taken at every step.
+            rep = self._listening()
+            changes = self._changes(rep, userdata)
+            active = _labels(active_states)
+            last, self.last = self.last, None
+            to = active[0] if active else None
+            if last is None:  # a child whose outcome the edges tell, or that ran before this machine was watched
+                frm = self.active[0] if self.active else "None"
+                last = (frm, self._outcome_to(frm, to))
+            self.active = active
+            if rep is not None:
+                rep.send(build.transition, self.path, last[0], last[1], to, active, changes)
         except Exception:
             self._failed("transition")
 
@@ -127,7 +165,13 @@ class ContainerWatch:
                              {label: self.outcomes.get(label) for label in self._children()}, ABSENT, changes)
                     return
                 returned = self.last
-                state_outcome = ABSENT if not self.started else (returned[1] if returned is not None else None)
+                if not self.started:
+                    state_outcome = ABSENT
+                elif returned is not None:
+                    state_outcome = returned[1]
+                else:  # a child whose outcome the edges tell
+                    lead = self.leads.get(last[0]) if last else None
+                    state_outcome = lead[1].get(outcome) if lead is not None else None
                 rep.send(build.terminate, self.path, last, outcome, [], state_outcome, ABSENT, ABSENT, changes)
         except Exception:
             self._failed("termination")
@@ -212,15 +256,12 @@ class ContainerWatch:
         if changes is not ABSENT:
             rep.send(build.userdata, self.path, changes)
 
-    def _outcome_to(self, to: str | None) -> str:
-        """The outcome of the previous active state that leads to ``to`` (its container's edges), for
-        a child that returned before the machine was watched; '?' when its edges do not say."""
-        if self.active:
-            leading = [str(o) for o, frm, target in self.container.get_internal_edges()
-                       if str(frm) == self.active[0] and str(target) == to]
-            if len(leading) == 1:
-                return leading[0]
-        return "?"
+    def _outcome_to(self, frm: str, to: str | None) -> str:
+        """The outcome of ``frm`` that leads to ``to`` (its container's edges), for a child whose
+        outcome they tell or that returned before the machine was watched; '?' when they do not say."""
+        lead = self.leads.get(frm)
+        outcome = lead[0].get(to) if lead is not None else None
+        return "?" if outcome is None else outcome
 
     def _current_label(self) -> str | None:
         label = getattr(self.container, "_current_label", None)
@@ -266,6 +307,16 @@ class Watched:
         self.own: ContainerWatch | None = None  # its own watch, when it is a container
         self.root = False  # it is the watched machine's root: its call is a run
 
+    @classmethod
+    def of(cls, state: Any) -> "Watched":
+        """The state's watch (its ``execute`` is the watch, or the watch's ``leaf``), made the first time."""
+        execute = state.execute
+        if isinstance(execute, Watched):
+            return execute
+        if isinstance(getattr(execute, "__self__", None), Watched) and execute.__func__ is Watched.leaf:
+            return execute.__self__
+        return cls(state, execute)
+
     def __call__(self, *args: Any, **kwargs: Any) -> Any:
         parent, own, label, root = self.parent, self.own, self.label, self.root
         watch = own if own is not None else parent
@@ -306,6 +357,28 @@ class Watched:
                 reporting.enter(rep, parent.path)
             else:
                 reporting.leave(prev)
+
+
+    def leaf(self, *args: Any, **kwargs: Any) -> Any:
+        """The call of a leaf whose outcome its container's edges tell (``ContainerWatch.told``),
+        inside its container's watched run: the call itself, and only what the edges cannot tell (an
+        exception; the debugger's gates, once one is armed, and its ``after`` gate when it was armed
+        while the leaf ran). Otherwise it is the whole call (``__call__``)."""
+        parent = self.parent
+        container = parent.container
+        if container._debugger is not None or not parent.entered:
+            return self(*args, **kwargs)
+        try:
+            outcome = self.inner(*args, **kwargs)
+        except BaseException as exc:
+            parent.child_failed(self.label, exc)
+            raise
+        dbg = container._debugger
+        if dbg is not None:  # armed while it ran: its outcome may be held or forced
+            if outcome is not None:
+                outcome = dbg.after(container, self.label, self.state, outcome)
+            parent.returned(self.label, outcome)
+        return outcome
 
 
 class PreemptWatched:

@@ -17,7 +17,10 @@ The comparison is what smach_ros pays per transition for its pickle, or less:
 - any other value (a user's object, a numpy array) is encoded each time.
 
 The userdata is only read, through its ``_data`` dict (read-only; reading ``ud._dirty`` or any
-other missing ``_`` name of the original raises inside its ``__getattr__``).
+other missing ``_`` name of the original raises inside its ``__getattr__``), copied in one call
+(``dict.copy``: no lock of the original taken, no ``__getattr__`` run, a Concurrence's child adding
+a key meanwhile changes nothing midway) and compared key by key in one loop written out: it runs
+for every key at every step.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ from .encoding import _key, encode
 # Values compared by type and value: the same value cannot differ in place.
 _ATOMS = frozenset((str, int, float, bool, type(None), bytes, complex))
 _NO_COPY = object()  # a value with no built-in copy: encoded each time
+_NEW = object()  # the encoding of a key not seen before: differs from any
 
 
 def _copy(value: Any) -> Any:
@@ -60,22 +64,26 @@ class UserdataWatch:
         self._userdata: Any = None  # the UserData last read, and its dict (set once by the original)
         self._data: dict = {}
 
-    def _items(self, userdata: Any) -> list[tuple[Any, Any]]:
-        """The userdata's (key, value) pairs, never raising (a Concurrence's child may add a key meanwhile)."""
+    def _values(self, userdata: Any) -> dict:
+        """A copy of the userdata's dict, made in one call (a Concurrence's child may add a key
+        meanwhile); never raising."""
         if userdata is not self._userdata:
             self._userdata, self._data = userdata, _data(userdata)
         data = self._data
-        for _ in range(3):
-            try:
-                return list(data.items())
-            except RuntimeError:
-                continue
-        return []
+        try:
+            return data.copy()
+        except Exception:  # a mapping of a user's, or changed while copied (a key's own __eq__)
+            for _ in range(3):
+                try:
+                    return dict(data)
+                except RuntimeError:
+                    continue
+            return {}
 
     def snapshot(self, userdata: Any) -> dict:
         """Every key, encoded (a start's ``userdata``); kept to compare the next changes with."""
         seen = {}
-        for key, value in self._items(userdata):
+        for key, value in self._values(userdata).items():
             seen[key] = (_key(key), _kept(value), encode(value))
         self._seen = seen
         return {name: encoded for name, _, encoded in seen.values()}
@@ -86,26 +94,26 @@ class UserdataWatch:
         if seen is None:  # nothing reported yet in this run (observed from its middle): the baseline
             self.snapshot(userdata)
             return {}
+        values = self._values(userdata)
         changed = {}
-        for key, value in self._items(userdata):
-            before = seen.get(key)
-            if before is not None:
-                kept = before[1]
+        for key, value in values.items():
+            try:
+                name, kept, encoded = seen[key]
+            except KeyError:  # a new key
+                name, encoded = _key(key), _NEW
+            else:
                 if value is kept:
                     continue
-                if type(value) is type(kept):  # written out, not called: this runs for every key at every step
+                if type(value) is type(kept):
                     try:
                         if value == kept:
                             continue
                     except Exception:  # a value holding a user's object whose comparison raises
                         pass
-                name = before[0]
-            else:
-                name = _key(key)
-            encoded = encode(value)
-            if before is None or before[2] != encoded:
-                changed[name] = encoded
-            seen[key] = (name, _kept(value), encoded)
+            new = encode(value)
+            if new != encoded or type(new) is not type(encoded):  # 3.0 is not 3, nor True 1, on the page
+                changed[name] = new
+            seen[key] = (name, value if type(value) in _ATOMS else _copy(value), new)
         return changed
 
     def forget(self) -> None:

@@ -23,6 +23,7 @@ debugger's hold); ``Reporter.deliver`` does the same for an observer that closes
 from __future__ import annotations
 
 import collections
+import os
 import threading
 import time
 from typing import Any, Protocol
@@ -96,7 +97,11 @@ class _Delivery:
             while True:
                 largest = 0
                 while ready:
-                    largest = max(largest, ready.popleft().deliver())
+                    reporter = ready.popleft()
+                    try:
+                        largest = max(largest, reporter.deliver())
+                    except Exception:  # said once; the thread goes on for every other machine
+                        reporter._failed(reporter.deliver, "delivering its events")
                 if largest >= BUSY_BATCH:
                     time.sleep(INTERVAL)
                     continue
@@ -106,4 +111,11 @@ class _Delivery:
                 self._idle = False
 
 
+    def _forget_after_fork(self) -> None:
+        """In a child process made by fork: the thread did not come along; the next event starts one."""
+        self.__init__()
+
+
 delivery = _Delivery()
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=delivery._forget_after_fork)

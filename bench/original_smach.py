@@ -21,7 +21,8 @@ The cost of a watcher is the time it adds per transition (1/watched - 1/bare rat
 cost on an original machine is no more than smach_ros's (its pickle); it is also given as a ratio of
 smach_ros's publishing. The rounds are interleaved (round r runs every case once, in turn, so the
 drift of this shared computer's speed hits every case alike; a short round first warms up): each
-cost is the median of the rounds' costs, with their range, each ratio the median of the rounds' ratios.
+cost is the median of the rounds' costs, with their range; fsmscope's ratio to smach_ros's is that of
+their medians.
 
 The speed of this shared computer drifts by half between runs of seconds, so ``--instructions``
 adds what does not: the instructions a transition costs (valgrind's callgrind, every thread of the
@@ -195,37 +196,39 @@ def of_smach_ros(ratio: float, publishing_ratio: float | None) -> str:
 
 def spread(costs: list[float]) -> str:
     """The median cost of the rounds, and their range."""
-    return "+%.1f us/transition (%.1f to %.1f)" % (statistics.median(costs), min(costs), max(costs))
+    return "%+.1f us/transition (%+.1f to %+.1f)" % (statistics.median(costs), min(costs), max(costs))
 
 
 def rate_rows(rates: dict[tuple, list[float]], skipped: str | None) -> list[tuple[str, str, str, str]]:
-    """The wall-clock rows of each workload: rates of the bare machines, each watcher's cost per
-    transition (the rounds' median and range) and fsmscope's as ratios of smach_ros's (the rounds' medians)."""
+    """The wall-clock rows of each workload: rates of the bare machines (fsm's as the median of the
+    rounds' ratios to the original's), each watcher's cost per transition (the rounds' median and
+    range) and fsmscope's costs as ratios of smach_ros's median costs (a cost of a few microseconds
+    is within a round's noise: a ratio per round would divide by it)."""
     def costs(workload: str, smach: str, watcher: str) -> list[float]:
         return [cost_us(bare, watched) for bare, watched in zip(rates[(workload, smach, BARE)],
                                                                  rates[(workload, smach, watcher)])]
 
-    def ratio(values: list[float], to: list[float]) -> float:
-        return statistics.median(value / reference for value, reference in zip(values, to))
-
     rows = []
     for workload in WORKLOADS:
         smach_bare, fsm_bare = rates[(workload, "smach", BARE)], rates[(workload, "fsm", BARE)]
-        ros = costs(workload, "smach", SMACH_ROS)
+        ros = statistics.median(costs(workload, "smach", SMACH_ROS))
         publishing = None if skipped else costs(workload, "smach", PUBLISHING)
+        published = publishing and statistics.median(publishing)
         watched, fsm_watched = costs(workload, "smach", FSMSCOPE), costs(workload, "fsm", FSMSCOPE)
-        watched_ratio = ratio(watched, ros)
+        watched_cost, fsm_watched_cost = statistics.median(watched), statistics.median(fsm_watched)
         rows += [
             ("%s: original smach, bare" % workload, "-", "%s/s" % f"{statistics.median(smach_bare):,.0f}", ""),
             ("%s: fsm, bare" % workload, "-", "%s/s (x%.2f of smach)" % (
-                f"{statistics.median(fsm_bare):,.0f}", ratio(fsm_bare, smach_bare)), ""),
-            ("%s: smach_ros's IntrospectionServer on smach" % workload, "-", spread(ros), ""),
+                f"{statistics.median(fsm_bare):,.0f}",
+                statistics.median(fsm / smach for fsm, smach in zip(fsm_bare, smach_bare))), ""),
+            ("%s: smach_ros's IntrospectionServer on smach" % workload, "-",
+             spread(costs(workload, "smach", SMACH_ROS)), ""),
             ("%s: smach_ros's IntrospectionServer, publishing to a subscriber (real rospy, rosmaster)" % workload, "-",
              "skipped: %s" % skipped if publishing is None else spread(publishing), ""),
             ("%s: fsmscope watching smach" % workload, "<= smach_ros's", "%s (%s)" % (spread(watched), of_smach_ros(
-                watched_ratio, publishing and ratio(watched, publishing))), verdict(watched_ratio <= 1)),
+                watched_cost / ros, published and watched_cost / published)), verdict(watched_cost <= ros)),
             ("%s: fsmscope watching fsm" % workload, "-", "%s (%s)" % (spread(fsm_watched), of_smach_ros(
-                ratio(fsm_watched, ros), publishing and ratio(fsm_watched, publishing))), ""),
+                fsm_watched_cost / ros, published and fsm_watched_cost / published)), ""),
         ]
     return rows
 

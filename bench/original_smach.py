@@ -27,7 +27,7 @@ their medians.
 The speed of this shared computer drifts by half between runs of seconds, so ``--instructions``
 adds what does not: the instructions a transition costs (valgrind's callgrind, every thread of the
 process, the server's and rospy's included; not the subscriber's, in its own process), runs of
-``COUNTED`` transitions less runs of none (about fifteen minutes).
+``COUNTED`` transitions less runs of none (15–25 minutes; smach_ros publishing runs about 100 s each).
 
     .venv/bin/python bench/original_smach.py [--runs 7] [--instructions]
 """

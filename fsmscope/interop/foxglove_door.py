@@ -92,6 +92,7 @@ class Door:
         self.host, self.port, self.inner_port, self.admission = host, port, inner_port, admission
         self.on_first_refusal = on_first_refusal
         self.refused = 0
+        self.visitors = 0  # connections admitted and open
         self._tls = ssl.SSLContext(ssl.PROTOCOL_TLS_CLIENT)
         self._tls.check_hostname = False  # the inner port is ours, on the loopback: TLS is for browsers' sake
         self._tls.verify_mode = ssl.CERT_NONE
@@ -134,9 +135,11 @@ class Door:
             return
         inner_writer.write(head)
         both = [asyncio.ensure_future(_pipe(reader, inner_writer)), asyncio.ensure_future(_pipe(inner_reader, writer))]
+        self.visitors += 1
         try:
             await asyncio.wait(both, return_when=asyncio.FIRST_COMPLETED)
         finally:
+            self.visitors -= 1
             for task in both:
                 task.cancel()
             writer.close()

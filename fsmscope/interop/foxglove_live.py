@@ -56,6 +56,10 @@ class FoxgloveLive:
                 if channel.has_sinks():
                     channel.log(m.data if m.schema is not None else m.data.encode(), log_time=nanoseconds(m.t))
 
+    def watched(self) -> bool:
+        """Whether a Foxglove client is connected (through the door)."""
+        return self.door.visitors > 0
+
     def stop(self) -> None:
         self.door.stop()
         self.server.stop()

@@ -250,3 +250,22 @@ def test_refused_handshakes_are_said_once_and_the_start_up_line_says_who_may_con
     assert sum("Foxglove connection was refused" in line for line in said) == 1, said
     assert len(said) < 5, said
     assert "https://app.foxglove.dev, http://tools.internal:8080 may connect" in proc.said[-1]
+
+
+def test_nothing_is_converted_for_foxglove_while_no_client_is_connected():
+    fsm.set_loggers(*(lambda msg: None,) * 4)
+    srv = ServerThread().start()
+    try:
+        sm = two_state_loop(20)
+        srv.hub.add_local(sm, name="loop")
+        live = start_foxglove(foxglove_args(), srv.hub)
+        fed = []
+        live.event = fed.append
+        try:
+            sm.execute()
+            time.sleep(0.3)  # the pump looks every 50 ms
+        finally:
+            live.stop()
+    finally:
+        srv.stop()
+    assert fed == []

@@ -1,7 +1,8 @@
 """``--foxglove PORT``: the served machines on the Foxglove WebSocket protocol too
 (fsmscope/interop/foxglove_live.py), fed from the hub as a dashboard's websocket is: each machine's events
 from its feed's ring, on the server's event loop (where the ring changes), and its snapshot when it
-joins or falls further behind than the ring keeps. A command that serves no dashboard (``run
+joins or falls further behind than the ring keeps; only while a Foxglove client is connected (a
+server nobody looks at costs the machines nothing). A command that serves no dashboard (``run
 --no-serve``, ``demo --headless``) has no hub: it gives the server its machines' events by
 observing them (``fsm.attach(machine, live.event)``), in their threads."""
 
@@ -65,8 +66,15 @@ def start_foxglove(args: argparse.Namespace, hub: Hub) -> FoxgloveLive:
 
 
 async def _pump(hub: Hub, live: FoxgloveLive) -> None:
+    """Feed ``live`` each machine's events from its feed's ring, while a Foxglove client is connected:
+    with none, nothing is converted, and one that connects has each machine start from a snapshot
+    (as a machine that fell behind the ring does)."""
     fed: dict[str, int] = {}  # machine -> the seq of the last event fed
     while True:
+        if not live.watched():
+            fed.clear()
+            await asyncio.sleep(POLL_SECONDS)
+            continue
         for entry in hub.machines():
             last = fed.get(entry.name)
             lines = entry.feed.encoded_from(last + 1, BATCH) if last is not None else None

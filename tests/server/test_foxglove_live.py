@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import asyncio
 import concurrent.futures
+import contextlib
 import json
 import os
 import queue
@@ -58,25 +59,33 @@ async def watch(port: int, topic: str, started: threading.Event, want: int) -> t
         return channels, got
 
 
-def test_a_foxglove_client_sees_the_channels_and_the_active_state_change():
+@contextlib.contextmanager
+def looping_with_foxglove():
+    """A server serving 'loop' (a two-state loop of 20 rounds, not started) and a Foxglove server fed
+    from its hub: (the machine, the Foxglove server)."""
     fsm.set_loggers(*(lambda msg: None,) * 4)
     srv = ServerThread().start()
     try:
         sm = two_state_loop(20)
         srv.hub.add_local(sm, name="loop")
         live = start_foxglove(foxglove_args(), srv.hub)
+        try:
+            yield sm, live
+        finally:
+            live.stop()
+    finally:
+        srv.stop()
+
+
+def test_a_foxglove_client_sees_the_channels_and_the_active_state_change():
+    with looping_with_foxglove() as (sm, live):
         started = threading.Event()
         runner = threading.Thread(target=lambda: started.wait(10) and sm.execute(), daemon=True)
         runner.start()
-        try:
-            with concurrent.futures.ThreadPoolExecutor(1) as own_loop:  # the suite's thread may run a loop
-                channels, states = own_loop.submit(asyncio.run, watch(live.port, "/fsmscope/loop/state", started,
-                                                                      10)).result()
-        finally:
-            live.stop()
+        with concurrent.futures.ThreadPoolExecutor(1) as own_loop:  # the suite's thread may run a loop
+            channels, states = own_loop.submit(asyncio.run, watch(live.port, "/fsmscope/loop/state", started,
+                                                                  10)).result()
         runner.join(10)
-    finally:
-        srv.stop()
     assert channels["/fsmscope/loop/state"]["schemaName"] == "fsmscope.State"
     assert channels["/fsmscope/loop/events"]["schemaName"] == "fsmscope.Event"
     assert (channels["/fsmscope/log"]["schemaName"], channels["/fsmscope/log"]["encoding"]) == ("foxglove.Log", "protobuf")
@@ -253,19 +262,9 @@ def test_refused_handshakes_are_said_once_and_the_start_up_line_says_who_may_con
 
 
 def test_nothing_is_converted_for_foxglove_while_no_client_is_connected():
-    fsm.set_loggers(*(lambda msg: None,) * 4)
-    srv = ServerThread().start()
-    try:
-        sm = two_state_loop(20)
-        srv.hub.add_local(sm, name="loop")
-        live = start_foxglove(foxglove_args(), srv.hub)
+    with looping_with_foxglove() as (sm, live):
         fed = []
         live.event = fed.append
-        try:
-            sm.execute()
-            time.sleep(0.3)  # the pump looks every 50 ms
-        finally:
-            live.stop()
-    finally:
-        srv.stop()
+        sm.execute()
+        time.sleep(0.3)  # the pump looks every 50 ms
     assert fed == []

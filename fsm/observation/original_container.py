@@ -1,6 +1,9 @@
 """One container of a machine of the original SMACH, watched: its callbacks and its children's calls
 made into the events an fsm container reports (docs/events.md).
 
+One piece because a container's callbacks and its children's wrapped calls share one record of the
+run (the last outcome, the failure, the outcomes of a Concurrence's children).
+
 The original tells a container's start, transitions and termination through the callbacks it offers
 (``register_start_cb``, ``register_transition_cb``, ``register_termination_cb``, as smach_ros's
 IntrospectionServer uses them); not which outcome caused a transition, what a child raised, nor
@@ -16,9 +19,6 @@ observing is said once on stderr (``Reporter._failed``).
 
 The debugger's gates (fsm/debugging/debugger.py) are called as fsm's containers call them: before
 and after a child's ``execute``, when the container has a ``_debugger``.
-
-One piece because a container's callbacks and its children's wrapped calls share one record of the
-run (the last outcome, the failure, the outcomes of a Concurrence's children).
 """
 
 from __future__ import annotations

@@ -114,7 +114,8 @@ class Recorder:
 
     def attached(self, reporter: Any) -> None:
         """``fsm.attach`` gave this recorder a machine: its snapshots are taken from the Status its
-        reporter folds (read in the reporter's ``send``, which holds that Status's lock)."""
+        reporter folds (read in ``take_batch``, which its reporter's ``deliver`` calls holding that
+        Status's lock), and closing has that reporter deliver what it made first."""
         status, _ = reporter.folded_status()
         with self._lock:
             self._reporters.append(reporter)

@@ -86,12 +86,9 @@ class Status:
                 written = event.get("changes")  # a userdata event's, or those its step's transition carries
                 if written is not None:
                     _write(entry, written)
-                if kind == "transition":  # ``_settle``, written out
-                    if not entry["written"]:
-                        entry["changes"] = {}
-                    entry["written"] = False
+                if kind == "transition":
                     entry["active"] = event["active"]  # events are never changed once emitted: no copy
-                    entry["last"] = {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq}
+                    _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq})
                 continue
             self._apply_other(event, kind, path)
             containers, run = self.containers, self.run  # a snapshot or a structure replaces them

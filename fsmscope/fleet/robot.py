@@ -262,7 +262,7 @@ class ZenohRobot:
                current: Callable[[], Status]) -> Callable[[tuple[int, bytes]], None]:
         """Publish a machine its host observes anyway (the dashboard's hub, as ``run --zenoh`` and
         ``demo --zenoh`` compose them), instead of observing it too: the host gives the returned
-        callable each event as (seq, its JSON), in the machine's thread; controls are applied through
+        callable each event as (seq, its JSON), in the thread that delivers it; controls are applied through
         the host's ``handle``; state queries are answered from the host's ``Status`` (``current()``,
         read holding ``lock``). The robot then keeps no Status and encodes nothing: publishing costs
         the machine one call per event (bench/fleet_cost.py)."""

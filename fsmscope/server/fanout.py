@@ -1,7 +1,7 @@
 """The fan-out: how a machine's events get from its thread to every browser that watches it.
 
-Threads: the machine's reporter calls the machine's ``Observer`` in the machine's thread, which
-gives the event to its ``feed.Feed`` (the Status, the hand-off, the ring: fsmscope/server/feed.py); the
+Threads: the machine's reporter gives the machine's ``Observer`` each batch of events in the
+delivery's thread (fsm/observation/delivery.py), which gives them to its ``feed.Feed`` (the Status, the hand-off, the ring: fsmscope/server/feed.py); the
 ``Fanout`` wakes the event loop with ``call_soon_threadsafe`` when no wake-up is pending, and the
 loop takes the hand-off into the ring. The loop owns the ring and the clients.
 

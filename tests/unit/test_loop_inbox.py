@@ -4,7 +4,7 @@ import asyncio
 import concurrent.futures
 import threading
 
-from fsmscope.server.cli.fleet_bridge import LoopInbox
+from fsmscope.server.cli.loop_inbox import LoopInbox
 
 
 def run_in_thread(work) -> None:

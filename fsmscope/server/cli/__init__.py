@@ -27,7 +27,7 @@ import signal
 import sys
 from typing import Protocol
 
-from . import bag_import, demo, export, replay, router, run, serve
+from . import bag_import, demo, export, replay, ros1, ros2, router, run, serve
 from .cannot_serve import CannotServe
 
 
@@ -41,7 +41,8 @@ class Subcommand(Protocol):
 
 
 SUBCOMMANDS: dict[str, Subcommand] = {"run": run, "serve": serve, "replay": replay, "export": export,
-                                      "import": bag_import, "demo": demo, "router": router}
+                                      "import": bag_import, "demo": demo, "router": router,
+                                      "ros1": ros1, "ros2": ros2}
 
 
 def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:

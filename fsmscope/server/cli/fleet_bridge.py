@@ -10,16 +10,15 @@ only batches and answers that prove it are shown (fsmscope/fleet/proofs.py)."""
 from __future__ import annotations
 
 import argparse
-import asyncio
-import collections
 import sys
 import threading
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 from fsm.control.controls import Refused
 
 from ..remote_control import RemoteHandle, not_connected, remote_controls, taken
 from .cannot_serve import CannotServe
+from .loop_inbox import LoopInbox
 from .serving import SWITCH_INTERVAL
 from .zenoh_options import reach, zenoh_tokens
 
@@ -74,39 +73,6 @@ class FleetLink:
             print("fsmscope serve: robot %r was not told of the lease on %r: %s" % (
                 self.robot, self.machine, "no answer" if answer is None else answer.get("detail")),
                 file=sys.stderr, flush=True)
-
-
-class LoopInbox:
-    """What the watcher's threads hand to the event loop, in order: calls queued, run together when the
-    watcher says the samples that came together are handled (``wake``). A fleet's robots put on the
-    same tick, so its thousands of batches a second wake the loop a few hundred times, not once per
-    batch: each wake costs the loop more than ingesting an event does."""
-
-    def __init__(self, loop: asyncio.AbstractEventLoop) -> None:
-        self.loop = loop
-        self._calls: collections.deque[tuple[Callable[..., None], tuple]] = collections.deque()
-        self._lock = threading.Lock()
-        self._scheduled = False
-
-    def post(self, call: Callable[..., None], *args: object) -> None:
-        """From any thread: ``call(*args)`` on the loop, after those posted before it, at the next ``wake``."""
-        self._calls.append((call, args))
-
-    def wake(self) -> None:
-        """From any thread: run what was posted, unless the loop is about to."""
-        with self._lock:
-            if self._scheduled or not self._calls:
-                return
-            self._scheduled = True
-        self.loop.call_soon_threadsafe(self._run)
-
-    def _run(self) -> None:
-        with self._lock:
-            self._scheduled = False
-        calls = self._calls
-        for _ in range(len(calls)):  # those posted meanwhile come with a wake of their own
-            call, args = calls.popleft()
-            call(*args)
 
 
 def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:

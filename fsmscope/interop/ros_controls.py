@@ -29,9 +29,9 @@ from .ros_watcher import INIT_SUFFIX, RosWatcher
 
 STOP_TOPIC = "/sm_stop"
 IN_PROCESS_ONLY = ("hold", "start", "pause", "resume", "step", "force", "breakpoints")
-NEEDS_IN_PROCESS = ("%s is not among what smach_ros's IntrospectionServer takes from outside (set initial state, "
-                    "and preempt through the machine's MonitorState): it needs fsmscope's IntrospectionServer in "
-                    "the robot's process (fsmscope.IntrospectionServer where smach_ros's stands; docs/ros.md)")
+NEEDS_IN_PROCESS = ("smach_ros's IntrospectionServer takes only Set initial state, and Preempt through the machine's "
+                    "MonitorState: pause, step, breakpoints, forced outcomes and start need fsmscope's "
+                    "IntrospectionServer in the robot's process (where smach_ros's stands; docs/ros.md)")
 
 
 def plain(value: Any, where: str = "userdata") -> Any:
@@ -56,7 +56,7 @@ def plain(value: Any, where: str = "userdata") -> Any:
 def _in_process_only(action: str) -> Any:
     """A control smach_ros does not take: recorded, then refused (its last argument is the client)."""
     def refused(self: RosControls, *args: Any) -> int:
-        return self._refuse(action, args[-1], 409, NEEDS_IN_PROCESS % action.capitalize())
+        return self._refuse(action, args[-1], 409, NEEDS_IN_PROCESS)
     refused.__name__ = action
     return refused
 
@@ -81,7 +81,7 @@ class RosControls:
         machine = self.watcher.machine(self.name)
         if machine is None or not machine.up:
             return Capabilities(unavailable="machine %r: its robot stopped publishing" % self.name)
-        return Capabilities(cannot={action: NEEDS_IN_PROCESS % action.capitalize() for action in IN_PROCESS_ONLY})
+        return Capabilities(cannot=dict.fromkeys(IN_PROCESS_ONLY, NEEDS_IN_PROCESS))
 
     def preempt(self, reason: str | None, client: str) -> int:
         self._up()

@@ -71,6 +71,8 @@ class MachineInfo(BaseModel):
     can_hold: bool = Field(default=False, description="its host runs it in a loop that POST .../hold can stop "
                            "after the current run")
     held: bool = Field(default=False, description="a hold was asked and no start has come since")
+    cannot: dict[str, str] = Field(default_factory=dict, description="the controls it never takes, each with why "
+                                   "(a ROS robot's machine: those smach_ros does not take)")
     source: Literal[SOURCES]  # type: ignore[valid-type]
     controllable: bool = Field(default=False, description="its controls would be taken now: a machine of this "
                                "process, or one whose publishing process takes them and is connected")

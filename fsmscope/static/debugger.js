@@ -73,6 +73,10 @@ export class DebugBar {
     const now = state.live?.debug ?? { mode: "run", holds: [] };
     const paused = now.mode !== "run" || now.holds.length > 0;
     const can = showsLive(state) && !this.controls.refusal();
+    const never = this.store.current()?.cannot?.pause; // its host takes no debugger control: say why
+    const limits = $("debug-limits");
+    limits.hidden = !never || this.controls.viewer;
+    if (never) setText(limits, never);
     const enabled = {
       "pause-btn": !paused && Boolean(state.live?.running),
       "resume-btn": paused,
@@ -81,7 +85,7 @@ export class DebugBar {
       "force-btn": this._forceTargets().length > 0,
     };
     for (const id of BUTTONS) {
-      $(id).hidden = this.controls.viewer;
+      $(id).hidden = this.controls.viewer || Boolean(never);
       $(id).disabled = !can || !enabled[id];
     }
   }

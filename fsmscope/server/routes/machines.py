@@ -26,7 +26,7 @@ async def list_machines(hub: HubDep) -> list[dict]:
         out.append({"name": entry.name, "running": entry.running(), "outcome": status.outcome,
                     "last_seq": status.last_seq, "root_path": status.root_path,
                     "can_start": capabilities.can("start"), "controllable": capabilities.unavailable is None,
-                    "can_hold": capabilities.can("hold"), "held": bool(controls.held),
+                    "can_hold": capabilities.can("hold"), "held": bool(controls.held), "cannot": dict(capabilities.cannot),
                     "source": origin.source, "connected": origin.connected, "rejected": origin.rejected,
                     "replay": origin.replay, "script": origin.script})
     return out

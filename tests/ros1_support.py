@@ -39,28 +39,34 @@ def skip_without_ros1() -> None:
         pytest.skip(reason)
 
 
+DASHBOARD_LINE = r"^dashboard: (http://\S+)$"  # what a robot serving fsmscope's dashboard prints first
+
+
 class Ros1(ros1.Ros1):
     """A private ROS 1 whose nodes can be tests/robots/'s robots."""
 
-    def robot(self, script: str, *args: str) -> Robot:
-        """``python tests/robots/SCRIPT ARGS...`` as a node of this master."""
+    def robot(self, script: str, *args: str, ready: str = DASHBOARD_LINE) -> Robot:
+        """``python tests/robots/SCRIPT ARGS...`` as a node of this master, once it printed a line that
+        matches ``ready``."""
         return Robot([sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args],
-                     self.robot_env(), self.home)
+                     self.robot_env(), self.home, ready)
 
 
 class Robot:
-    """A robot's process, in a group of its own: ``url``, the dashboard's address it printed first
-    (``dashboard: URL``); ``output``, all it printed (both streams, in order) so far."""
+    """A robot's process, in a group of its own: ``url``, what the first line that matched ``ready``
+    said (the dashboard's address of a robot that serves one: ``dashboard: URL``); ``output``, all it
+    printed (both streams, in order) so far."""
 
-    def __init__(self, argv: list[str], env: dict[str, str], cwd: Path) -> None:
+    def __init__(self, argv: list[str], env: dict[str, str], cwd: Path, ready: str = DASHBOARD_LINE) -> None:
         self.proc = subprocess.Popen(argv, env=env, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                                      text=True, start_new_session=True)
         self._lines: list[str] = []
+        self._ready = re.compile(ready, re.M)
         self._reader = threading.Thread(target=self._read, daemon=True)
         self._reader.start()
         try:
-            self.url = wait_for(self._printed_url, 60, interval=0.05, what=lambda: "the robot to print its URL:\n"
-                                + self.output)
+            self.url = wait_for(self._printed_ready, 60, interval=0.05, what=lambda: "the robot to print %r:\n%s"
+                                % (ready, self.output))
         except (RuntimeError, TimeoutError):
             self.stop()
             raise
@@ -73,12 +79,12 @@ class Robot:
     def output(self) -> str:
         return "".join(self._lines)
 
-    def _printed_url(self) -> str | None:
-        found = re.search(r"^dashboard: (http://\S+)$", self.output, re.M)
+    def _printed_ready(self) -> str | None:
+        found = self._ready.search(self.output)
         if found is None and self.proc.poll() is not None:
-            raise RuntimeError("the robot exited with %d before printing its URL:\n%s" % (self.proc.returncode,
-                                                                                           self.output))
-        return found.group(1) if found else None
+            raise RuntimeError("the robot exited with %d before it was ready:\n%s" % (self.proc.returncode,
+                                                                                        self.output))
+        return (found.group(1) if found.groups() else found.group(0)) if found else None
 
     def api(self) -> httpx.Client:
         """A client of the robot's dashboard, holding the token its URL carries."""

@@ -1,12 +1,12 @@
 """A ROS 1 robot nobody may change: the original SMACH with smach_ros's own IntrospectionServer on
 rospy, and nothing of fsmscope. Run by tests/ros1/ against a real rosmaster as
-``smach_ros_robot.py NODE SERVER [ROUNDS]``: node NODE publishes its machine as server SERVER, runs it
-again one second after each run ends, prints ``ready`` once it publishes, ``outcome: X`` after each
-run, and spins until it is stopped.
+``smach_ros_robot.py NODE SERVER STOP_TOPIC [ROUNDS]``: node NODE publishes its machine as server
+SERVER, runs it again one second after each run ends, prints ``ready`` once it publishes,
+``outcome: X`` after each run, and spins until it is stopped.
 
 /SM_ROOT
   RUN (Concurrence: whichever child ends first ends it, the other preempted)
-    MONITOR  smach_ros.MonitorState on /sm_stop (std_msgs/Empty): a message there -> 'invalid' -> RUN 'stopped'
+    MONITOR  smach_ros.MonitorState on STOP_TOPIC (std_msgs/Empty): a message there -> 'invalid' -> RUN 'stopped'
     WORK     MOVE -> SCAN -> MOVE ... (each 0.3 s of ROS time); MOVE counts the rounds in the userdata,
              SCAN ends WORK 'done' after ROUNDS rounds (default 1000: until stopped)
   RUN 'stopped' -> DOCK -> 'stopped'; RUN 'done' -> 'done'
@@ -19,8 +19,8 @@ import smach
 import smach_ros
 from std_msgs.msg import Empty
 
-NODE, SERVER = sys.argv[1], sys.argv[2]
-ROUNDS = int(sys.argv[3]) if len(sys.argv) > 3 else 1000
+NODE, SERVER, STOP_TOPIC = sys.argv[1:4]
+ROUNDS = int(sys.argv[4]) if len(sys.argv) > 4 else 1000
 
 
 class Timed(smach.State):
@@ -74,7 +74,7 @@ def build():
                             input_keys=["rounds"], output_keys=["rounds"], child_termination_cb=lambda outcomes: True,
                             outcome_map={"stopped": {"MONITOR": "invalid"}, "done": {"WORK": "done"}})
     with run:
-        smach.Concurrence.add("MONITOR", smach_ros.MonitorState("/sm_stop", Empty, lambda ud, msg: False))
+        smach.Concurrence.add("MONITOR", smach_ros.MonitorState(STOP_TOPIC, Empty, lambda ud, msg: False))
         smach.Concurrence.add("WORK", work)
 
     root = smach.StateMachine(outcomes=["stopped", "done", "preempted"])

@@ -9,12 +9,14 @@ package (yaml, pygments).
 
 from __future__ import annotations
 
+import contextlib
 import re
 import subprocess
 import sys
 import threading
 import urllib.parse
 from pathlib import Path
+from typing import Iterator
 
 import httpx
 import pytest
@@ -128,3 +130,63 @@ def logged_lines(output: str, first_line: re.Pattern) -> list[tuple[str, str]]:
             lines[-1] = (lines[-1][0], lines[-1][1] + "\n" + text)
         in_message = bool(found) or (in_message and text.startswith("\t"))
     return lines
+
+
+READY = r"^ready$"  # what tests/robots/smach_ros_robot.py prints once it publishes
+
+
+@contextlib.contextmanager
+def two_robots(ros: Ros1) -> Iterator[dict[str, Robot]]:
+    """Robots nobody may change (tests/robots/smach_ros_robot.py): r1 (node /robot1, server /r1, stop
+    topic /r1/sm_stop) and r2 (node /robot2, ...), by their machines' names; the dict may be given
+    new robots, which are stopped too."""
+    robots = {name: ros.robot("smach_ros_robot.py", node, "/" + name, "/%s/sm_stop" % name, ready=READY)
+              for name, node in (("r1", "robot1"), ("r2", "robot2"))}
+    try:
+        yield robots
+    finally:
+        for robot in robots.values():
+            robot.stop()
+
+
+class Live:
+    """A real ``fsmscope ros1`` process following ``ros``'s master, recording to ``recording``, each
+    robot of ``two_robots`` preempted on its own stop topic."""
+
+    def __init__(self, ros: Ros1, recording: Path) -> None:
+        from fleet_support import started
+
+        self.recording = recording
+        self.proc, found = started(["ros1", "--master", ros.master_uri, "--port", "0", "--record", str(recording),
+                                    "--stop-topic", "r1=/r1/sm_stop", "--stop-topic", "r2=/r2/sm_stop"],
+                                   r"dashboard at (http://\S+)")
+        self.url = found.group(1)
+        self.base, self.token = self.url.split("/?token=")
+
+    def get(self, path: str, **params) -> httpx.Response:
+        return httpx.get(self.base + path, params={"token": self.token, **params}, timeout=10)
+
+    def post(self, path: str, body: dict) -> httpx.Response:
+        return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
+
+    def machines(self) -> dict[str, dict]:
+        return {m["name"]: m for m in self.get("/api/machines").json()}
+
+    def events(self, name: str, kinds: str = "start,transition,terminate,control") -> list[dict]:
+        answer = self.get("/api/machines/%s/history" % name, kinds=kinds, limit=10000)
+        assert answer.status_code == 200, answer.text
+        return answer.json()["events"]
+
+
+@contextlib.contextmanager
+def live_viewer(ros: Ros1) -> Iterator[Live]:
+    """``Live`` once it shows both robots' machines; stopped at the end."""
+    from fleet_support import stop
+
+    viewer = Live(ros, ros.home / "live.jsonl")
+    try:
+        wait_for(lambda: {"r1", "r2"} <= set(viewer.machines()), 30, interval=0.1,
+                 what=lambda: "both robots' machines on the dashboard: %s" % viewer.machines())
+        yield viewer
+    finally:
+        stop(viewer.proc)

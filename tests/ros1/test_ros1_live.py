@@ -8,61 +8,24 @@ from __future__ import annotations
 
 import re
 import signal
-from pathlib import Path
 
-import httpx
 import pytest
 from fsmscope.server.testing.polling import wait_for
 
-from fleet_support import started, stop
+from fleet_support import stop
 from recording_support import cli
-from ros1_support import Robot, rospy_lines
-
-READY = r"^ready$"
-
-
-class Live:
-    """``fsmscope ros1`` against the module's master, recording to ``recording``."""
-
-    def __init__(self, ros, recording: Path) -> None:
-        self.recording = recording
-        self.proc, found = started(["ros1", "--master", ros.master_uri, "--port", "0", "--record", str(recording),
-                                    "--stop-topic", "r1=/r1/sm_stop", "--stop-topic", "r2=/r2/sm_stop"],
-                                   r"dashboard at (http://\S+)")
-        self.base, self.token = found.group(1).split("/?token=")
-
-    def get(self, path: str, **params) -> httpx.Response:
-        return httpx.get(self.base + path, params={"token": self.token, **params}, timeout=10)
-
-    def post(self, path: str, body: dict) -> httpx.Response:
-        return httpx.post(self.base + path, params={"token": self.token}, json=body, timeout=10)
-
-    def machines(self) -> dict[str, dict]:
-        return {m["name"]: m for m in self.get("/api/machines").json()}
-
-    def events(self, name: str, kinds: str = "start,transition,terminate,control") -> list[dict]:
-        answer = self.get("/api/machines/%s/history" % name, kinds=kinds, limit=10000)
-        assert answer.status_code == 200, answer.text
-        return answer.json()["events"]
-
+from ros1_support import READY, Robot, live_viewer, rospy_lines, two_robots
 
 @pytest.fixture(scope="module")
 def robots(ros):
-    """Robot r1 (node /robot1) and r2 (node /robot2), running before the viewer joins."""
-    started_robots = {name: ros.robot("smach_ros_robot.py", node, "/" + name, "/%s/sm_stop" % name, ready=READY)
-                      for name, node in (("r1", "robot1"), ("r2", "robot2"))}
-    yield started_robots
-    for robot in started_robots.values():
-        robot.stop()
+    with two_robots(ros) as started_robots:
+        yield started_robots
 
 
 @pytest.fixture(scope="module")
 def live(ros, robots):
-    viewer = Live(ros, ros.home / "live.jsonl")
-    wait_for(lambda: {"r1", "r2"} <= set(viewer.machines()), 30, interval=0.1,
-             what=lambda: "both robots' machines on the dashboard: %s" % viewer.machines())
-    yield viewer
-    stop(viewer.proc)
+    with live_viewer(ros) as viewer:
+        yield viewer
 
 
 def _moved(events: list[dict]) -> list[dict]:

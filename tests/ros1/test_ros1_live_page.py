@@ -30,7 +30,7 @@ def live(ros, robots):
         yield viewer
 
 
-def active_in_work(page, name: str) -> str | None:
+def active_in_work(page) -> str | None:
     return page.evaluate("""() => [...document.querySelectorAll('#graph g.node.active')].map(g => g.id)
                                    .find(id => id.startsWith('s:/SM_ROOT/RUN/WORK/')) || null""")
 
@@ -38,8 +38,8 @@ def active_in_work(page, name: str) -> str | None:
 @pytest.mark.parametrize("name", ["r1", "r2"])
 def test_the_page_follows_each_robots_machine_live(browser, live, name):
     with page_at(browser, live.url + "#m=" + name, "#badge.live", scene=False) as page:
-        first = wait_for(lambda: active_in_work(page, name), 30, interval=0.05, what="a state of WORK shown active")
-        wait_for(lambda: active_in_work(page, name) not in (None, first), 30, interval=0.05,
+        first = wait_for(lambda: active_in_work(page), 30, interval=0.05, what="a state of WORK shown active")
+        wait_for(lambda: active_in_work(page) not in (None, first), 30, interval=0.05,
                  what="another state of WORK than %s shown active" % first)
 
 

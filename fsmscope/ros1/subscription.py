@@ -19,7 +19,7 @@ from typing import Any, Callable
 
 from . import tcpros
 from .errors import Ros1Error
-from .master import call
+from .master import Unreachable, call
 from .messages import MessageType
 
 PROBLEMS_KEPT = 20
@@ -69,6 +69,7 @@ class Subscription:
         self._lock = threading.Lock()
         self._links: dict[str, _Link] = {}  # publisher API URI -> its connection, connecting or connected
         self._closed = False
+        self._unreachable: set[str] = set()  # publisher APIs said not to answer (a killed robot stays listed)
 
     @property
     def problems(self) -> list[str]:
@@ -91,6 +92,7 @@ class Subscription:
             if self._closed:
                 return
             gone = [link for uri, link in self._links.items() if uri not in uris]
+            self._unreachable &= set(uris)
             for link in gone:
                 del self._links[link.uri]
             for uri in uris:
@@ -115,6 +117,13 @@ class Subscription:
 
     def said(self, problem: str) -> None:
         self._problems.append(problem)
+
+    def _first_unreachable(self, uri: str) -> bool:
+        """Whether ``uri`` is said not to answer for the first time since the master listed it."""
+        with self._lock:
+            first = uri not in self._unreachable
+            self._unreachable.add(uri)
+        return first
 
     def _connected(self, link: _Link, caller_id: str) -> bool:
         with self._lock:
@@ -186,6 +195,10 @@ class _Link:
         try:
             try:
                 caller_id = self._connect()
+            except Unreachable as error:
+                if not self._closing.is_set() and sub._first_unreachable(self.uri):
+                    sub.said("the publisher at %s of %s does not answer: %s" % (self.uri, sub.topic, error))
+                return
             except Ros1Error as error:
                 if not self._closing.is_set():
                     sub.said("not connected to the publisher at %s of %s: %s" % (self.uri, sub.topic, error))

@@ -62,7 +62,8 @@ class MessageType:
         try:
             message = self._twin.deserialize_ros1(raw, self._typename)
         except Exception as error:  # rosbags' generated code raises struct.error, IndexError, ValueError...
-            raise Ros1Error("%d bytes that are no %s: %s" % (len(raw), self.name, error or type(error).__name__)) from error
+            reason = str(error) or type(error).__name__
+            raise Ros1Error("%d bytes that are no %s: %s" % (len(raw), self.name, reason)) from error
         return self._plain(message, self._typename)
 
     def encode(self, fields: dict[str, Any]) -> bytes:
@@ -98,7 +99,8 @@ class MessageType:
 
     def _built(self, fields: Any, typename: str, where: str) -> Any:
         if typename in _TIME_TYPES and isinstance(fields, (int, float)) and math.isfinite(fields):
-            fields = {"sec": math.floor(fields), "nanosec": round((fields - math.floor(fields)) * 1e9) % 1_000_000_000}
+            sec, nanosec = divmod(round(fields * 1e9), 1_000_000_000)
+            fields = {"sec": sec, "nanosec": nanosec}
         if not isinstance(fields, dict):
             raise Ros1Error("%s: a message is given as a dict, not %s" % (where, type(fields).__name__))
         spec_of = dict(self._fields[typename][1])
@@ -117,15 +119,17 @@ class MessageType:
                 return _base(value, spec[0])
             (item_kind, item_spec), count = spec
             items = [] if value is None else value
+            as_bytes = isinstance(items, (bytes, bytearray)) and item_spec[0] in ("uint8", "char")
+            if not as_bytes and not isinstance(items, (list, tuple)):
+                raise TypeError("an array is a list, not %s" % type(items).__name__)
             if item_kind == Nodetype.NAME:
-                items = list(items) or [{}] * count
+                items = items or [{}] * count
                 built = [self._built(item, item_spec, "%s[%d]" % (where, i)) for i, item in enumerate(items)]
             elif item_spec[0] == "string":
-                built = [_base(item, "string_item") for item in (list(items) or [""] * count)]
+                built = [_base(item, "string_item") for item in (items or [""] * count)]
             else:
                 dtype = _DTYPES.get(item_spec[0], item_spec[0])
-                built = (np.frombuffer(items, dtype=np.uint8) if isinstance(items, (bytes, bytearray))
-                         else np.array(list(items), dtype=dtype))
+                built = np.frombuffer(items, dtype=np.uint8) if as_bytes else np.array(items, dtype=dtype)
                 built = built if len(built) or not count else np.zeros(count, dtype=dtype)
             if kind == Nodetype.ARRAY and len(built) != count:
                 raise Ros1Error("%s holds %d items, not %d" % (where, count, len(built)))

@@ -95,7 +95,8 @@ def test_published_topics_name_each_topic_with_its_ros1_type(ros, node):
 
 def test_an_initial_status_command_reaches_a_rospy_subscriber(ros, node):
     publication = node.advertise("/cmd/smach/container_init", "smach_msgs/SmachContainerInitialStatusCmd")
-    echo = RospyNode(ros, "/init_echo", "echo", "/cmd/smach/container_init", "smach_msgs/SmachContainerInitialStatusCmd")
+    echo = RospyNode(ros, "/init_echo", "echo", "/cmd/smach/container_init",
+                     "smach_msgs/SmachContainerInitialStatusCmd")
     try:
         wait_for(lambda: publication.subscribers == ["/init_echo"], 20, what=lambda: str(publication.subscribers))
         publication.publish({"path": "/SM_ROOT", "initial_states": ["SCAN"], "local_data": "gAJ9cQAu"})

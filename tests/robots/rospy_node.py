@@ -5,6 +5,8 @@ Debian's Python with rospy and smach_msgs' generated classes (tests/rospy_suppor
     rospy_node.py NAME broken TOPIC      publishes SmachContainerStatus, every other message cut short
     rospy_node.py NAME string TOPIC      publishes std_msgs/String (another type on a smach_msgs name)
     rospy_node.py NAME echo TOPIC TYPE   prints each message of TYPE (pkg/Type) as a JSON line
+    rospy_node.py NAME smach SERVER      runs an original SMACH machine (A -> B -> A ...) that
+                                         smach_ros's own IntrospectionServer SERVER introspects
 
 It prints ``ready`` once its publisher or subscriber exists, and runs until it is killed.
 """
@@ -13,6 +15,7 @@ import io
 import json
 import pickle
 import sys
+import threading
 
 import genpy
 import roslib.message
@@ -55,11 +58,35 @@ def echo(message):
     print(json.dumps(plain(message)), flush=True)
 
 
+def run_smach(server):
+    import smach
+    import smach_ros
+
+    class Step(smach.State):
+        def __init__(self):
+            smach.State.__init__(self, outcomes=["next"])
+
+        def execute(self, userdata):
+            rospy.sleep(0.1)
+            return "next"
+
+    machine = smach.StateMachine(outcomes=["never"])
+    with machine:
+        smach.StateMachine.add("A", Step(), transitions={"next": "B"})
+        smach.StateMachine.add("B", Step(), transitions={"next": "A"})
+    smach_ros.IntrospectionServer(server, machine, "/SM_ROOT").start()
+    threading.Thread(target=machine.execute, daemon=True).start()
+    print("ready", flush=True)
+    rospy.spin()
+
+
 def main(name, mode, topic, *rest):
     rospy.init_node(name.lstrip("/"))
     rate = rospy.Rate(20)
     number = 0
-    if mode == "echo":
+    if mode == "smach":
+        run_smach(topic)
+    elif mode == "echo":
         rospy.Subscriber(topic, roslib.message.get_message_class(rest[0]), echo)
         print("ready", flush=True)
         rospy.spin()

@@ -5,10 +5,12 @@ from __future__ import annotations
 
 import base64
 import pickle
+import subprocess
 import threading
 
 import pytest
 from fsmscope.ros1 import Node, Received, Ros1Error
+from fsmscope.ros1.messages import message_type
 from fsmscope.server.testing.demo_process import free_port
 from fsmscope.server.testing.polling import wait_for
 
@@ -54,6 +56,24 @@ def node(ros, request):
 def subscribed(node: Node, topic: str, type_name: str = STATUS):
     inbox = Inbox()
     return inbox, node.subscribe(topic, type_name, inbox.on_message, inbox.on_publishers)
+
+
+# Each type's md5sum as the classes genpy generates (rospy's) have it.
+GENPY_MD5SUMS = """
+import importlib, sys
+for name in sys.argv[1:]:
+    package, short = name.split("/")
+    print(getattr(importlib.import_module(package + ".msg"), short)._md5sum)
+"""
+
+
+def test_the_md5sums_are_those_of_the_classes_genpy_generates(ros):
+    names = ["smach_msgs/SmachContainerStatus", "smach_msgs/SmachContainerStructure",
+             "smach_msgs/SmachContainerInitialStatusCmd", "std_msgs/Empty", "rosgraph_msgs/Log"]
+    genpy = subprocess.run(["/usr/bin/python3", "-c", GENPY_MD5SUMS, *names], env=ros.robot_env(),
+                           capture_output=True, text=True, timeout=60)
+    assert genpy.returncode == 0, genpy.stderr
+    assert [message_type(name).md5sum for name in names] == genpy.stdout.split()
 
 
 def test_a_rospy_status_reaches_the_node_as_plain_fields_with_its_stamp_and_publisher(ros, node):
@@ -112,6 +132,35 @@ def test_a_latched_empty_reaches_rostopic_echo_started_after_it_was_published(ro
     echo = ros.rostopic("echo", "-n", "1", "/latched_stop")
     printed = echo.communicate(timeout=30)[0]
     assert echo.returncode == 0 and printed.strip() == "---", printed
+
+
+def test_smach_ros_introspection_server_is_found_by_type_and_takes_an_initial_state_from_the_node(ros, node):
+    """The original SMACH with smach_ros's own IntrospectionServer: its topics found by their types,
+    its structure and status read, and a SmachContainerInitialStatusCmd of ours obeyed (it publishes
+    the new initial state and userdata as a status saying REMOTE_INIT)."""
+    robot = RospyNode(ros, "/smach_robot", "smach", "patrol")
+    try:
+        def smach_topics() -> dict[str, str] | None:
+            found = {topic: kind for topic, kind in node.published_topics().items()
+                     if kind.startswith("smach_msgs/") and topic.startswith("/patrol/")}  # others: earlier tests
+            return found if len(found) == 2 else None
+        topics = wait_for(smach_topics, 20, interval=0.1, what="the introspection server's topics")
+        structures, _ = subscribed(node, "/patrol/smach/container_structure", "smach_msgs/SmachContainerStructure")
+        statuses, _ = subscribed(node, "/patrol/smach/container_status")
+        init = node.advertise("/patrol/smach/container_init", "smach_msgs/SmachContainerInitialStatusCmd")
+        wait_for(lambda: init.subscribers == ["/smach_robot"], 20, what=lambda: str(init.subscribers))
+        userdata = base64.b64encode(pickle.dumps({"rounds": 7}, 2)).decode()
+        init.publish({"path": "/SM_ROOT", "initial_states": ["B"], "local_data": userdata})
+        remote = wait_for(lambda: [m for m in statuses.messages if m.fields["info"] == "REMOTE_INIT"], 20,
+                          what="the status answering our initial state")[0]
+        structure = wait_for(lambda: structures.messages, 20, what="a structure")[0]
+    finally:
+        robot.kill()
+    assert topics == {"/patrol/smach/container_structure": "smach_msgs/SmachContainerStructure",
+                      "/patrol/smach/container_status": STATUS}
+    assert (structure.fields["path"], structure.fields["children"]) == ("/SM_ROOT", ["A", "B"])
+    assert remote.fields["initial_states"] == ["B"] and remote.publisher == "/smach_robot"
+    assert pickle.loads(base64.b64decode(remote.fields["local_data"])) == {"rounds": 7}
 
 
 def test_a_publisher_killed_leaves_the_connected_publishers_and_a_new_one_joins(ros, node):

@@ -87,20 +87,17 @@ class Subscription:
             return [(uri, link.caller_id) for uri, link in self._links.items() if link.caller_id is not None]
 
     def update_publishers(self, uris: list[str]) -> None:
-        """The topic's publishers are now ``uris``: connect to the new, disconnect from the gone."""
+        """The master says the topic's publishers are ``uris``: connect to those not connected. A
+        connection to one it no longer lists is kept, as rospy keeps it: a publisher that leaves
+        closes it, and a restarted master lists only the publishers that registered with it since."""
         with self._lock:
             if self._closed:
                 return
-            gone = [link for uri, link in self._links.items() if uri not in uris]
             self._unreachable &= set(uris)
-            for link in gone:
-                del self._links[link.uri]
             for uri in uris:
                 if uri not in self._links:
                     self._links[uri] = _Link(self, uri)
                     self._links[uri].start()
-        for link in gone:
-            link.close()
 
     def close(self) -> None:
         """Disconnects from every publisher (and the node unregisters the subscription); no callback

@@ -217,6 +217,8 @@ def test_a_master_that_is_not_running_is_said_and_not_waited_for():
 
 
 def test_a_subscription_resumes_with_a_master_restarted_on_the_same_port(tmp_path):
+    """The node registers again with the new master, so a robot started after the restart is
+    connected; the robot from before (rospy does not register again) goes on being read."""
     ros = Ros1(tmp_path).start()
     ours = Node(ros.master_uri, "/wire_restart")
     robots = [RospyNode(ros, "/before_restart", "status", "/again/smach/container_status")]
@@ -230,6 +232,8 @@ def test_a_subscription_resumes_with_a_master_restarted_on_the_same_port(tmp_pat
         robots.append(RospyNode(ros, "/after_restart", "status", "/again/smach/container_status"))
         wait_for(lambda: inbox.from_("/after_restart"), 20, what=lambda: "a status from a robot started after the "
                  "restart; publishers: %s" % inbox.publishers)
+        before = len(inbox.from_("/before_restart"))
+        wait_for(lambda: len(inbox.from_("/before_restart")) > before, 10, what="the robot from before to go on")
     finally:
         for robot in robots:
             robot.kill()

@@ -67,6 +67,7 @@ class Subscription:
         self._on_close = on_close
         self._problems: collections.deque[str] = collections.deque(maxlen=PROBLEMS_KEPT)
         self._lock = threading.Lock()
+        self._telling = threading.Lock()  # on_publishers gets the sets in the order they were
         self._links: dict[str, _Link] = {}  # publisher API URI -> its connection, connecting or connected
         self._closed = False
         self._unreachable: set[str] = set()  # publisher APIs said not to answer (a killed robot stays listed)
@@ -141,16 +142,18 @@ class Subscription:
     def _tell_publishers(self) -> None:
         if self._on_publishers is None or self._closed:
             return
-        try:
-            self._on_publishers(self.publishers)
-        except Exception as error:  # the caller's callback: said, never the end of our reader
-            self.said("on_publishers raised %s: %s" % (type(error).__name__, error))
+        with self._telling:
+            try:
+                self._on_publishers(self.publishers)
+            except Exception as error:  # the caller's callback: said, never the end of our reader
+                self.said("on_publishers raised %s: %s" % (type(error).__name__, error))
 
     def _received(self, publisher: str, raw: bytes, t: float) -> None:
         try:
             fields = self.kind.decode(raw)
         except Ros1Error as error:
-            self.undecodable += 1
+            with self._lock:
+                self.undecodable += 1
             self.said("a message from %s on %s does not decode: %s" % (publisher, self.topic, error))
             return
         stamp = None

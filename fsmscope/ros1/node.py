@@ -108,6 +108,7 @@ class Node:
     def close(self) -> None:
         """Unregisters everything (if the master answers), closes every connection and the node's APIs."""
         self._stop.set()
+        self._watchdog.join(5)  # it registers nothing again after this
         with self._lock:
             subscriptions = [s for topic in self._subscriptions.values() for s in topic]
             publications = list(self._publications.values())
@@ -117,7 +118,6 @@ class Node:
             publication.close()
         self._listener.close()
         self._api.close()
-        self._watchdog.join(5)
 
     # --- what the node's API reads and is told (fsmscope/ros1/slave.py's NodeState)
 

@@ -15,7 +15,6 @@ from typing import Any, Callable
 from . import tcpros
 from .errors import Ros1Error
 from .messages import MessageType
-from .subscription import tune
 
 SEND_TIMEOUT = 5.0  # a subscriber that reads nothing for this long is dropped, not waited for
 
@@ -65,8 +64,6 @@ class Publication:
                 caller_id, self.topic, header.get("type", "?"), header.get("md5sum", "?"), self.caller_id,
                 self.kind.name, self.kind.md5sum))
             return
-        if header.get("tcp_nodelay") == "1":
-            sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
         with self._lock:
             try:
                 if self._closed:
@@ -129,7 +126,7 @@ def serve_connection(sock: socket.socket, publications: dict[str, Publication]) 
     """A connection to the node's TCPROS port: its header says which publication it is for."""
     try:
         sock.settimeout(SEND_TIMEOUT)
-        tune(sock)
+        tcpros.tune(sock)
         header = tcpros.read_header(sock)
     except (OSError, Ros1Error):
         sock.close()

@@ -39,16 +39,6 @@ class Received:
     stamp: float | None
 
 
-def tune(sock: socket.socket) -> None:
-    """No Nagle delay (a transition must reach the page in milliseconds) and keepalive probes, so a
-    robot that vanishes from the network without closing is noticed in about ten seconds."""
-    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
-    for option, value in (("TCP_KEEPIDLE", 4), ("TCP_KEEPINTVL", 2), ("TCP_KEEPCNT", 3)):
-        if hasattr(socket, option):
-            sock.setsockopt(socket.IPPROTO_TCP, getattr(socket, option), value)
-
-
 class Subscription:
     """The subscription of node ``caller_id`` to ``topic`` of type ``kind``: ``on_message(Received)``
     per message, in order per publisher; ``on_publishers(caller ids)`` when the connected set
@@ -230,7 +220,7 @@ class _Link:
         if self._closing.is_set():
             raise Ros1Error("closed")
         try:
-            tune(self._sock)
+            tcpros.tune(self._sock)
             tcpros.write_header(self._sock, {"callerid": sub.caller_id, "topic": sub.topic,
                                              "md5sum": sub.kind.md5sum, "type": sub.kind.name,
                                              "message_definition": sub.kind.definition, "tcp_nodelay": "1"})

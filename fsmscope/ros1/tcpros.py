@@ -51,6 +51,16 @@ def decode_header(body: bytes) -> dict[str, str]:
     return fields
 
 
+def tune(sock: socket.socket) -> None:
+    """No Nagle delay (a transition must reach the page in milliseconds) and keepalive probes, so a
+    robot that vanishes from the network without closing is noticed in about ten seconds."""
+    sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+    sock.setsockopt(socket.SOL_SOCKET, socket.SO_KEEPALIVE, 1)
+    for option, value in (("TCP_KEEPIDLE", 4), ("TCP_KEEPINTVL", 2), ("TCP_KEEPCNT", 3)):
+        if hasattr(socket, option):
+            sock.setsockopt(socket.IPPROTO_TCP, getattr(socket, option), value)
+
+
 def frame(payload: bytes) -> bytes:
     """A message as it goes on the wire: its length, then its bytes."""
     return _LENGTH.pack(len(payload)) + payload

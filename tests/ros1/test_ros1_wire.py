@@ -7,6 +7,7 @@ import base64
 import pickle
 import subprocess
 import threading
+import xmlrpc.client
 
 import pytest
 from fsmscope.ros1 import Node, Received, Ros1Error
@@ -239,3 +240,47 @@ def test_a_subscription_resumes_with_a_master_restarted_on_the_same_port(tmp_pat
             robot.kill()
         ours.close()
         ros.stop()
+
+
+def test_a_publication_is_found_by_a_subscriber_started_after_the_master_restarted(tmp_path):
+    ros = Ros1(tmp_path).start()
+    ours = Node(ros.master_uri, "/wire_restart_publisher")
+    echo = None
+    try:
+        publication = ours.advertise("/again_stop", "std_msgs/Empty", latch=True)
+        publication.publish({})
+        ros.stop()
+        wait_for(lambda: not ours.master_connected, 10, what="the node to see the master gone")
+        ros.start()
+        wait_for(lambda: ours.master_connected, 10, what="the node to see the master back")
+        echo = RospyNode(ros, "/late_echo", "echo", "/again_stop", "std_msgs/Empty")
+        wait_for(echo.messages, 20, what=lambda: "the latched message after the restart:\n" + echo.output)
+    finally:
+        if echo is not None:
+            echo.kill()
+        ours.close()
+        ros.stop()
+
+
+def test_a_subscriber_that_leaves_is_no_longer_among_the_publications_subscribers(ros, node):
+    publication = node.advertise("/leaving_stop", "std_msgs/Empty")
+    echo = RospyNode(ros, "/leaving_echo", "echo", "/leaving_stop", "std_msgs/Empty")
+    try:
+        wait_for(lambda: publication.subscribers == ["/leaving_echo"], 20, what=lambda: str(publication.subscribers))
+    finally:
+        echo.kill()
+    wait_for(lambda: publication.subscribers == [], 20, what=lambda: str(publication.subscribers))
+
+
+def test_closing_the_node_unregisters_its_subscriptions_and_publications(ros):
+    ours = Node(ros.master_uri, "/wire_closing")
+    ours.subscribe("/closing/smach/container_status", STATUS, lambda received: None)
+    ours.advertise("/closing/smach/container_init", "smach_msgs/SmachContainerInitialStatusCmd")
+
+    def registered() -> set[str]:
+        publishers, subscribers, _ = xmlrpc.client.ServerProxy(ros.master_uri).getSystemState("/test")[2]
+        return {topic for topic, nodes in publishers + subscribers if "/wire_closing" in nodes}
+
+    assert registered() == {"/closing/smach/container_status", "/closing/smach/container_init"}
+    ours.close()
+    assert registered() == set()

@@ -284,3 +284,20 @@ def test_closing_the_node_unregisters_its_subscriptions_and_publications(ros):
     assert registered() == {"/closing/smach/container_status", "/closing/smach/container_init"}
     ours.close()
     assert registered() == set()
+
+
+def test_a_subscription_made_before_the_master_runs_is_registered_when_it_does(tmp_path):
+    ros = Ros1(tmp_path)
+    ours = Node(ros.master_uri, "/wire_early")
+    robot = None
+    try:
+        inbox, _ = subscribed(ours, "/early/smach/container_status")
+        assert ours.master_connected is False
+        ros.start()
+        robot = RospyNode(ros, "/late_robot", "status", "/early/smach/container_status")
+        wait_for(lambda: inbox.from_("/late_robot"), 20, what="a status once the master runs")
+    finally:
+        if robot is not None:
+            robot.kill()
+        ours.close()
+        ros.stop()

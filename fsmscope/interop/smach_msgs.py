@@ -1,4 +1,4 @@
-"""smach_msgs' two introspection messages, registered with rosbags from their definitions.
+"""smach_msgs' three introspection messages, registered with rosbags from their definitions.
 
 The fields are those of ros/executive_smach's smach_msgs/msg/*.msg (the same since fuerte); on
 its ROS 2 branch ``local_data`` is ``uint8[]`` (a raw pickle) where ROS 1 has a ``string``
@@ -15,6 +15,7 @@ from rosbags.typesys.store import Typestore
 
 STRUCTURE = "smach_msgs/msg/SmachContainerStructure"
 STATUS = "smach_msgs/msg/SmachContainerStatus"
+INITIAL_STATUS_CMD = "smach_msgs/msg/SmachContainerInitialStatusCmd"  # a viewer's "set initial state"
 STRUCTURE_TOPIC = "/smach/container_structure"  # after the introspection server's name
 STATUS_TOPIC = "/smach/container_status"
 
@@ -33,14 +34,19 @@ string[] active_states
 {local_data} local_data
 string info
 """
+_INITIAL_STATUS_CMD = """string path
+string[] initial_states
+{local_data} local_data
+"""
 
 
 def typestore(ros2: bool, local_data_bytes: bool = False) -> Typestore:
-    """A typestore with the two messages: ROS 2's (``local_data`` bytes) or ROS 1's (``local_data`` a
+    """A typestore with the three messages: ROS 2's (``local_data`` bytes) or ROS 1's (``local_data`` a
     string, or bytes when ``local_data_bytes``)."""
     store = get_typestore(Stores.ROS2_HUMBLE if ros2 else Stores.ROS1_NOETIC)
     kind = "uint8[]" if ros2 or local_data_bytes else "string"
     types = get_types_from_msg(_STRUCTURE, STRUCTURE)
     types.update(get_types_from_msg(_STATUS.format(local_data=kind), STATUS))
+    types.update(get_types_from_msg(_INITIAL_STATUS_CMD.format(local_data=kind), INITIAL_STATUS_CMD))
     store.register(types)
     return store

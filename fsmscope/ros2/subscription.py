@@ -172,8 +172,8 @@ class Subscription:
         if status.total_count > self._incompatible:
             self._incompatible = status.total_count
             policy = POLICY_NAMES.get(status.last_policy_id, f"policy {status.last_policy_id}")
-            self._say(f"a publisher on {self.topic} offers a QoS ours cannot match ({policy}; fsmscope reads "
-                      f"reliable, volatile): its messages are not received")
+            self._say(f"a publisher on {self.topic} does not match this reader by DDS's {policy} policy (fsmscope "
+                      f"reads {self.type_name}, reliable, volatile): its messages are not received")
         matched = {key for _, key in self._writers.values()}
         now = time.monotonic()
         ours = dds_type(self.type_name)

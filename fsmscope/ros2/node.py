@@ -18,6 +18,7 @@ from cyclonedds.topic import Topic
 
 from fsmscope.ros2.config import check_domain_id, cyclone_config
 from fsmscope.ros2.dds import delete
+from fsmscope.ros2.messages import message_class
 from fsmscope.ros2.names import dds_topic, ros_topic, ros_type
 from fsmscope.ros2.publisher import Publisher
 from fsmscope.ros2.subscription import Received, Subscription
@@ -81,14 +82,16 @@ class Node:
     def subscribe(self, topic: str, type_name: str, on_message: Callable[[Received], None],
                   on_publishers: Callable[[list[str]], None] | None = None) -> Subscription:
         """Receive ``type_name`` messages on ``topic`` (fsmscope.ros2.subscription says how)."""
-        subscription = Subscription(self, topic, type_name, on_message, on_publishers)
+        dds_topic = self.topic(topic, message_class(type_name))
+        subscription = Subscription(self.participant, dds_topic, topic, type_name, self.publications, on_message,
+                                    on_publishers)
         with self._lock:
             self._subscriptions.append(subscription)
         return subscription
 
     def advertise(self, topic: str, type_name: str) -> Publisher:
         """A publisher of ``type_name`` messages on ``topic``."""
-        publisher = Publisher(self, topic, type_name)
+        publisher = Publisher(self.participant, self.topic(topic, message_class(type_name)), topic, type_name)
         with self._lock:
             self._publishers.append(publisher)
         return publisher

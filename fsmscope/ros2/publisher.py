@@ -8,26 +8,26 @@ publishing.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from cyclonedds.core import DDSException
+from cyclonedds.domain import DomainParticipant
 from cyclonedds.pub import DataWriter
+from cyclonedds.topic import Topic
 
 from fsmscope.ros2.dds import WRITER_QOS, delete
-from fsmscope.ros2.messages import from_fields, message_class
-
-if TYPE_CHECKING:
-    from fsmscope.ros2.node import Node
+from fsmscope.ros2.messages import from_fields
 
 
 class Publisher:
     """Messages of one type, published on one topic."""
 
-    def __init__(self, node: "Node", topic: str, type_name: str) -> None:
+    def __init__(self, participant: DomainParticipant, dds_topic: Topic, topic: str, type_name: str) -> None:
+        """A writer of ``dds_topic`` (``topic``'s, of ``type_name``'s class) in ``participant``."""
         self.topic = topic
         self.type_name = type_name
-        self._class = message_class(type_name)
-        self._writer = DataWriter(node.participant, node.topic(topic, self._class), qos=WRITER_QOS)
+        self._class = dds_topic.data_type
+        self._writer = DataWriter(participant, dds_topic, qos=WRITER_QOS)
 
     def publish(self, fields: dict[str, Any]) -> None:
         """Publish a message given as a dict (members left out are zero); ValueError for a member the

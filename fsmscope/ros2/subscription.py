@@ -14,18 +14,17 @@ import collections
 import threading
 import time
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Callable
+from typing import Any, Callable
 
 from cyclonedds.core import DDSException, DDSStatus, GuardCondition, InstanceState, ReadCondition, SampleState, ViewState, WaitSet
+from cyclonedds.domain import DomainParticipant
 from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
 from cyclonedds.util import duration
 
 from fsmscope.ros2.dds import POLICY_NAMES, READER_QOS, delete
-from fsmscope.ros2.messages import message_class, to_fields
+from fsmscope.ros2.messages import to_fields
 from fsmscope.ros2.names import dds_type, ros_type
-
-if TYPE_CHECKING:
-    from fsmscope.ros2.node import Node
 
 MAX_PROBLEMS = 100
 # How long a publisher on the topic may stay unmatched before it is said not to fit: matching
@@ -57,13 +56,17 @@ def _stamp(fields: dict[str, Any]) -> float | None:
 class Subscription:
     """Messages of one type on one topic, handed to ``on_message`` from the subscription's thread."""
 
-    def __init__(self, node: "Node", topic: str, type_name: str, on_message: Callable[[Received], None],
+    def __init__(self, participant: DomainParticipant, dds_topic: Topic, topic: str, type_name: str,
+                 publications: Callable[[str], list[Any]], on_message: Callable[[Received], None],
                  on_publishers: Callable[[list[str]], None] | None = None) -> None:
+        """A reader of ``dds_topic`` (``topic``'s, of ``type_name``'s class) in ``participant``;
+        ``publications(topic)`` lists the writers discovered on the topic (Node.publications)."""
         self.topic = topic
         self.type_name = type_name
         self.undecodable = 0
         self._problems: collections.deque[str] = collections.deque(maxlen=MAX_PROBLEMS)
-        self._node = node
+        self._participant = participant
+        self._publications = publications
         self._on_message = on_message
         self._on_publishers = on_publishers
         self._writers: dict[int, tuple[str, Any]] = {}   # matched writer's handle -> (participant, writer key)
@@ -71,11 +74,11 @@ class Subscription:
         self._unmatched_since: dict[Any, float] = {}
         self._said_unmatched: set[Any] = set()
         self._incompatible = 0
-        self._reader = DataReader(node.participant, node.topic(topic, message_class(type_name)), qos=READER_QOS)
+        self._reader = DataReader(participant, dds_topic, qos=READER_QOS)
         self._reader.set_status_mask(DDSStatus.SubscriptionMatched | DDSStatus.RequestedIncompatibleQos)
         self._closed = threading.Event()
-        self._guard = GuardCondition(node.participant)
-        self._waitset = WaitSet(node.participant)
+        self._guard = GuardCondition(participant)
+        self._waitset = WaitSet(participant)
         self._waitset.attach(ReadCondition(self._reader, SampleState.NotRead | ViewState.Any | InstanceState.Any))
         self._waitset.attach(self._reader)
         self._waitset.attach(self._guard)
@@ -178,8 +181,8 @@ class Subscription:
         now = time.monotonic()
         ours = dds_type(self.type_name)
         seen = set()
-        for publication in self._node.publications(self.topic):
-            if publication.key in matched or publication.participant_key == self._node.participant.guid:
+        for publication in self._publications(self.topic):
+            if publication.key in matched or publication.participant_key == self._participant.guid:
                 continue
             seen.add(publication.key)
             since = self._unmatched_since.setdefault(publication.key, now)

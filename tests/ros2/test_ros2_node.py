@@ -6,6 +6,8 @@ import pickle
 import threading
 import time
 
+import pytest
+
 from fsmscope.ros2 import Received
 from fsmscope.server.testing.polling import wait_for
 from ros2_support import ROBOT_LEASE, STATUS, STATUS_TOPIC, STRUCTURE
@@ -162,3 +164,11 @@ def test_smachs_log_lines_arrive_on_rosout_with_the_nodes_name(node, robots):
     assert line.fields["name"] == "robot_main"
     assert line.fields["level"] == 20
     assert line.stamp == line.fields["stamp"]["sec"] + line.fields["stamp"]["nanosec"] * 1e-9
+
+
+def test_a_value_the_message_cannot_hold_is_refused_before_anything_is_written(node):
+    init = node.advertise("/robot/smach/container_init", "smach_msgs/msg/SmachContainerInitialStatusCmd")
+    with pytest.raises(ValueError, match="cannot write"):
+        init.publish({"path": "/SM_ROOT", "local_data": [256]})
+    with pytest.raises(ValueError, match="no member"):
+        init.publish({"paths": "/SM_ROOT"})

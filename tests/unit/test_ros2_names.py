@@ -76,3 +76,12 @@ def test_an_interface_alone_keeps_multicast_discovery():
 def test_an_address_that_would_break_the_xml_is_refused():
     with pytest.raises(ValueError):
         cyclone_config('127.0.0.1"/><Peer address="10.0.0.1')
+
+
+def test_a_message_a_big_endian_machine_wrote_reads_the_same():
+    from cyclonedds.idl._support import Endianness
+    message = from_fields(SmachContainerStatus, {"path": "/SM", "active_states": ["A"], "local_data": b"\x80\x02",
+                                                 "header": {"stamp": {"sec": 3, "nanosec": 4}}})
+    big = message.serialize(endianness=Endianness.Big, use_version_2=False)
+    assert big[:2] == b"\x00\x00"  # CDR_BE
+    assert to_fields(SmachContainerStatus.deserialize(big)) == to_fields(message)

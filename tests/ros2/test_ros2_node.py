@@ -3,6 +3,7 @@ smach_ros/introspection.py, publishing over Cyclone DDS as rmw does, in a proces
 (tests/robots/ros2_robot.py), and impostors that publish on the same topic what is no SmachContainerStatus."""
 
 import pickle
+import re
 import threading
 import time
 
@@ -95,10 +96,11 @@ def test_container_init_from_fsmscope_sets_where_the_robots_next_run_starts(node
     assert remote.fields["initial_states"] == ["C"]
     assert remote.fields["local_data"] == pickle.dumps({"count": 100}, 2)
     # The command came while a run was going: its userdata at once, its initial state from the next run on.
-    wait_for(lambda: "State machine starting in initial state 'C'" in robot.output, 20, interval=0.02,
-             what=lambda: f"a run starting at C:\n{robot.output}")
-    counts = [int(line.split()[-1]) for line in robot.output.splitlines() if line.startswith("state: C ")]
-    assert counts and min(counts) > 100
+    started_at_c = "State machine starting in initial state 'C'"
+    wait_for(lambda: started_at_c in robot.output, 20, interval=0.02, what=lambda: f"a run starting at C:\n{robot.output}")
+    first_at_c = wait_for(lambda: re.search(r"^state: C (\d+)$", robot.output.split(started_at_c, 1)[1], re.M), 10,
+                          interval=0.02, what=lambda: f"C to run:\n{robot.output}")
+    assert int(first_at_c.group(1)) > 100
 
 
 def test_an_empty_message_on_sm_stop_preempts_the_robots_machine(node, robots):

@@ -15,6 +15,7 @@ objects.)
 """
 
 import dataclasses
+import functools
 import typing
 from typing import Any
 
@@ -104,18 +105,25 @@ def _is_bytes(hint: Any) -> bool:
     return any(isinstance(arg, sequence) and arg.subtype == uint8 for arg in typing.get_args(hint))
 
 
+@functools.cache
 def _members(cls: type) -> dict[str, Any]:
     return typing.get_type_hints(cls, include_extras=True)
+
+
+@functools.cache
+def _byte_members(cls: type) -> frozenset[str]:
+    return frozenset(name for name, hint in _members(cls).items() if _is_bytes(hint))
 
 
 def to_fields(message: Any) -> dict[str, Any]:
     """A received message as a plain dict (``uint8[]`` as bytes)."""
     fields: dict[str, Any] = {}
-    for name, hint in _members(type(message)).items():
+    byte_members = _byte_members(type(message))
+    for name in _members(type(message)):
         value = getattr(message, name)
         if dataclasses.is_dataclass(value):
             value = to_fields(value)
-        elif _is_bytes(hint):
+        elif name in byte_members:
             value = bytes(value)
         elif isinstance(value, list):
             value = [to_fields(item) if dataclasses.is_dataclass(item) else item for item in value]

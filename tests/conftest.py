@@ -11,7 +11,9 @@ Each folder is a layer, registered as a marker of the same name (``pytest -m uni
   shared by its tests (demo/conftest.py);
 * ``parity/``: fsm and the original SMACH run side by side;
 * ``ros1/``: a real ROS 1 (Debian's rosmaster, rospy and rostopic) and a robot on the original SMACH
-  with smach_ros, watched by fsmscope (tests/ros1_support.py).
+  with smach_ros, watched by fsmscope (tests/ros1_support.py);
+* ``ros2/``: robot processes publishing as a ROS 2 node's rmw does, over Cyclone DDS on the loopback
+  (each test on a domain id of its own), watched by fsmscope.ros2.
 
 Shared fixtures: captured log lines, the runtime's globals restored after every test, a live server,
 a private bus and its action servers, Debian's Chromium, and one recorded demo episode."""
@@ -169,7 +171,7 @@ def headless_demo_log(tmp_path_factory):
     return path
 
 
-LAYERS = ("unit", "server", "fleet", "browser", "demo", "parity", "ros1")
+LAYERS = ("unit", "server", "fleet", "browser", "demo", "parity", "ros1", "ros2")
 TESTS = Path(__file__).resolve().parent
 
 

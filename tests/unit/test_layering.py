@@ -4,9 +4,9 @@ fsm is the runtime: the standard library only (orjson when installed) and nothin
 the simulator. Inside fsm the core imports nothing but itself: it reports through its own seam
 (fsm/core/reporting.py), which observation implements; no extension (ros, logfiles, debugging,
 control) is imported by what it extends. sim never imports
-server; interop (bags, MCAP, Foxglove) and fleet (Zenoh) import neither; server imports sim, interop
-and fleet only in its composition root, the CLI (fsmscope/server/cli/). The ROS-free counterparts a
-script's run is given (fsmscope/counterparts/) import only fsm and themselves.
+server; interop (bags, MCAP, Foxglove) and fleet (Zenoh) import neither, ros2 (ROS 2 over DDS) none
+of them; server imports sim, interop, fleet and ros2 only in its composition root, the CLI
+(fsmscope/server/cli/). The ROS-free counterparts a script's run is given (fsmscope/counterparts/) import only fsm and themselves.
 """
 
 from __future__ import annotations
@@ -96,7 +96,9 @@ def test_fsm_imports_only_the_standard_library_and_its_own_lower_layers():
 # What each package beside fsm must never import: the server composes them, never the reverse.
 SERVER, SIM, INTEROP, FLEET = "fsmscope.server", "fsmscope.sim", "fsmscope.interop", "fsmscope.fleet"
 ROS1 = "fsmscope.ros1"  # the ROS 1 client: it uses interop's smach_msgs, nothing that composes it
-NEVER = {SIM: (SERVER,), INTEROP: (SERVER, SIM), FLEET: (SERVER, SIM, INTEROP), ROS1: (SERVER, SIM, FLEET)}
+ROS2 = "fsmscope.ros2"  # the ROS 2 client: its own messages, nothing that composes it
+NEVER = {SIM: (SERVER,), INTEROP: (SERVER, SIM), FLEET: (SERVER, SIM, INTEROP), ROS1: (SERVER, SIM, FLEET),
+         ROS2: (SERVER, SIM, INTEROP, FLEET)}
 
 
 @pytest.mark.parametrize("package", sorted(NEVER))
@@ -178,7 +180,7 @@ def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
     return sorted(found)
 
 
-@pytest.mark.parametrize("package", ["fsm", SERVER, FLEET, INTEROP, SIM, ROS1])
+@pytest.mark.parametrize("package", ["fsm", SERVER, FLEET, INTEROP, SIM, ROS1, ROS2])
 def test_no_import_cycle_among_a_packages_modules(package):
     assert cycles(import_graph(package)) == []
 

@@ -6,7 +6,8 @@ way: what a robot running smach_ros's own IntrospectionServer takes from outside
   userdata, which its next run starts from. The userdata travels as a protocol 2 pickle (base64 of it
   on ROS 1), which this module makes only from plain values (dict, list, tuple, str, numbers, bools,
   None): what the robot unpickles is never anything else.
-- Preempt publishes ``std_msgs/Empty`` on the machine's stop topic (``/sm_stop`` unless told),
+- Preempt publishes ``std_msgs/Empty`` on the machine's stop topic (``/sm_stop`` unless told:
+  ``RosWatcher``'s ``stop_topic``),
   which a MonitorState of the robot's machine listens to, as smach_viewer's users wire it.
 
 Pause, step, breakpoints, forced outcomes, hold and start need the machine's own process: smach_ros
@@ -25,9 +26,8 @@ from typing import Any
 from fsm.control.controls import Capabilities, Refused
 from fsm.observation.schema import build
 
-from .ros_watcher import INIT_SUFFIX, RosWatcher
+from .ros_watcher import INIT_SUFFIX, RosWatcher, Unheard
 
-STOP_TOPIC = "/sm_stop"
 IN_PROCESS_ONLY = ("hold", "start", "pause", "resume", "step", "force", "breakpoints")
 NEEDS_IN_PROCESS = ("smach_ros's IntrospectionServer takes only Set initial state, and Preempt through the machine's "
                     "MonitorState: pause, step, breakpoints, forced outcomes and start need fsmscope's "
@@ -66,10 +66,9 @@ class RosControls:
 
     held = False
 
-    def __init__(self, watcher: RosWatcher, name: str, stop_topic: str = STOP_TOPIC) -> None:
+    def __init__(self, watcher: RosWatcher, name: str) -> None:
         self.watcher = watcher
         self.name = name
-        self.stop_topic = stop_topic
 
     def _machine(self) -> Any:
         machine = self.watcher.machine(self.name)
@@ -84,9 +83,15 @@ class RosControls:
         return Capabilities(cannot=dict.fromkeys(IN_PROCESS_ONLY, NEEDS_IN_PROCESS))
 
     def preempt(self, reason: str | None, client: str) -> int:
-        self._up()
-        self.watcher.publish(self.stop_topic, self.watcher.flavour.empty, {})
-        return self.emit_control("preempt", client, "accepted", reason, {"topic": self.stop_topic})
+        topic = self._up().stop_topic
+        params = {"topic": topic}
+        try:
+            self.watcher.publish(topic, self.watcher.flavour.empty, {})
+        except Unheard:
+            return self._refuse("preempt", client, 409, "nobody subscribes to %s: no MonitorState of the robot's "
+                                "machine listens there now (it is not running, or waits on another topic: "
+                                "--stop-topic)" % topic, params)
+        return self.emit_control("preempt", client, "accepted", reason, params)
 
     def set_initial_state(self, path: str | None, states: list[str], userdata: dict | None, client: str) -> int:
         machine = self._up()
@@ -99,8 +104,13 @@ class RosControls:
         except ValueError as exc:
             return self._refuse("initial-state", client, 422, str(exc), params)
         local_data = base64.b64encode(data).decode("ascii") if self.watcher.flavour.base64_local_data else data
-        self.watcher.publish(machine.server + INIT_SUFFIX, self.watcher.flavour.init,
-                             {"path": path, "initial_states": list(states), "local_data": local_data})
+        topic = machine.server + INIT_SUFFIX
+        try:
+            self.watcher.publish(topic, self.watcher.flavour.init,
+                                 {"path": path, "initial_states": list(states), "local_data": local_data})
+        except Unheard:
+            return self._refuse("initial-state", client, 409, "nobody subscribes to %s: the robot's "
+                                "IntrospectionServer does not listen for initial states" % topic, params)
         return self.emit_control("initial-state", client, "accepted", None, params, path)
 
     def emit_control(self, action: str, client: str, result: str, reason: str | None = None,

@@ -30,7 +30,7 @@ from typing import Any, Callable, Protocol
 from fsm.observation import names
 
 from .bag_reader import Message
-from .smach_events import Follower
+from .smach_follower import Follower
 
 POLL = 1.0  # s between two looks for servers that came or went
 WINDOW = 0.02  # s a message waits for those stamped before it on the other topics (within the page's 50 ms)
@@ -38,6 +38,12 @@ STATUS_SUFFIX = "/smach/container_status"
 STRUCTURE_SUFFIX = "/smach/container_structure"
 INIT_SUFFIX = "/smach/container_init"
 ROSOUT = "/rosout"
+SUBSCRIBED_WAIT = 2.0  # s a control waits for a subscriber of its topic
+STOP_TOPIC = "/sm_stop"  # where a robot's MonitorState waits for std_msgs/Empty, unless told otherwise
+
+
+class Unheard(Exception):
+    """A message that no subscriber would take."""
 
 
 @dataclass(frozen=True)
@@ -80,6 +86,7 @@ class Machine:
     server: str  # the ROS name its topics hang under ("/robot1/sm")
     publisher: str  # the publishing node's id (ROS 1: its caller id, which /rosout's lines name)
     follower: Follower
+    stop_topic: str  # where its preempt is published
     up: bool = True
 
 
@@ -91,12 +98,14 @@ class RosWatcher:
 
     def __init__(self, node: Node, flavour: Flavour, deliver: Callable[[list[dict]], None],
                  seen: Callable[[str, bool], None], said: Callable[[str], None] | None = None,
-                 poll: float = POLL, window: float = WINDOW) -> None:
+                 stop_topic: Callable[[str], str] = lambda name: STOP_TOPIC, poll: float = POLL,
+                 window: float = WINDOW) -> None:
         self.node = node
         self.flavour = flavour
         self._deliver = deliver
         self._seen = seen
         self._said = said or (lambda text: print("fsmscope: %s" % text, file=sys.stderr, flush=True))
+        self._stop_topic = stop_topic
         self._poll = poll
         self._window = window
         self.machines: dict[tuple[str, str], Machine] = {}  # (server, publisher) -> its machine
@@ -107,6 +116,7 @@ class RosWatcher:
         self._waiting: list[tuple[float, int, float, str, Any]] = []  # (stamp, order, arrived, kind, received)
         self._order = itertools.count()
         self._lock = threading.Lock()  # the followers, the machines and the waiting messages
+        self._advertising = threading.Lock()  # the publications (a master's answer is not waited for under _lock)
         self._wake = threading.Condition(self._lock)
         self._stopped = threading.Event()
         self._threads = [threading.Thread(target=self._look, name="fsmscope-ros-look", daemon=True),
@@ -137,13 +147,35 @@ class RosWatcher:
             self._deliver([event])
             return event["seq"]
 
-    def publish(self, topic: str, type_name: str, fields: dict) -> None:
-        """``fields`` on ``topic`` (advertised the first time)."""
-        with self._lock:
+    def advertise(self, topic: str, type_name: str) -> Any:
+        """The publication of ``topic`` (made the first time): made when a machine is found, so that the
+        robot's subscriptions have connected to it (ROS 1) or matched it (DDS) before a control uses it."""
+        with self._advertising:
             publication = self._publications.get(topic)
             if publication is None:
                 publication = self._publications[topic] = self.node.advertise(topic, type_name)
+            return publication
+
+    def publish(self, topic: str, type_name: str, fields: dict, wait: float = SUBSCRIBED_WAIT) -> list[str]:
+        """``fields`` on ``topic``, once a subscriber is there (``wait`` seconds at most): the subscribers it
+        reached. ``Unheard`` when none is: a message nobody takes is not said to be sent."""
+        publication = self.advertise(topic, type_name)
+        deadline = time.monotonic() + wait
+        while not publication.subscribers and time.monotonic() < deadline:
+            time.sleep(0.02)
+        subscribers = publication.subscribers
+        if not subscribers:
+            raise Unheard("nobody subscribes to %s" % topic)
         publication.publish(fields)
+        return subscribers
+
+    def _advertise_controls(self, machine: Machine) -> None:
+        """The topics of the machine's controls, advertised as soon as it is found (``advertise``)."""
+        for topic, type_name in ((machine.stop_topic, self.flavour.empty), (machine.server + INIT_SUFFIX, self.flavour.init)):
+            try:
+                self.advertise(topic, type_name)
+            except Exception as exc:  # the control says so again when it is used
+                self._once("pub " + topic, "cannot advertise %s: %s" % (topic, exc))
 
     # The looking thread: servers that came.
     def _look(self) -> None:
@@ -237,7 +269,10 @@ class RosWatcher:
         if machine is None:
             name = names.unique(server.strip("/") or "smach", self._taken)
             self._taken.add(name)
-            machine = self.machines[key] = Machine(name, server, received.publisher, Follower(server, name))
+            machine = self.machines[key] = Machine(name, server, received.publisher, Follower(server, name),
+                                                   self._stop_topic(name))
+            threading.Thread(target=self._advertise_controls, args=(machine,), name="fsmscope-ros-advertise",
+                             daemon=True).start()
         elif not machine.up:
             machine.up = True
             self._seen(machine.name, True)

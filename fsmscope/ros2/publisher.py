@@ -2,7 +2,7 @@
 volatile, keep last 10, XCDR1), so that a robot's rclpy subscription receives what it writes.
 
 DDS delivers a volatile message only to the subscriptions matched when it is written, as ROS 2
-does: advertise ahead (``subscribers()`` says how many are matched) rather than just before
+does: advertise ahead (``subscribers`` lists those matched) rather than just before
 publishing.
 """
 
@@ -40,9 +40,11 @@ class Publisher:
         except Exception as exc:  # cyclonedds's serializer: a str where a number goes, a number > 255 in uint8[] ...
             raise ValueError(f"cannot write {fields!r} as {self.type_name}: {type(exc).__name__}: {exc}") from exc
 
-    def subscribers(self) -> int:
-        """How many subscriptions (readers) this publisher is matched with now."""
-        return len(self._writer.get_matched_subscriptions())
+    @property
+    def subscribers(self) -> list[str]:
+        """The subscriptions (readers) this publisher is matched with now, by their instance handles (as
+        fsmscope.ros1's ``Publication.subscribers`` lists its subscribers)."""
+        return [str(handle) for handle in self._writer.get_matched_subscriptions()]
 
     def close(self) -> None:
         delete(self._writer)

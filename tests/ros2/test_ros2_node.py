@@ -89,7 +89,7 @@ def test_container_init_from_fsmscope_sets_where_the_robots_next_run_starts(node
     node.subscribe(STATUS_TOPIC, STATUS, inbox.message)
     init = node.advertise("/robot/smach/container_init", "smach_msgs/msg/SmachContainerInitialStatusCmd")
     robot = robots()
-    wait_for(lambda: init.subscribers() >= 1, 20, interval=0.02, what="the robot's subscription to container_init")
+    wait_for(lambda: len(init.subscribers) >= 1, 20, interval=0.02, what="the robot's subscription to container_init")
     init.publish({"path": "/SM_ROOT", "initial_states": ["C"], "local_data": pickle.dumps({"count": 100}, 2)})
     remote = inbox.first(lambda m: m.fields["info"] == "REMOTE_INIT")
     assert remote.fields["path"] == "/SM_ROOT"
@@ -106,7 +106,7 @@ def test_container_init_from_fsmscope_sets_where_the_robots_next_run_starts(node
 def test_an_empty_message_on_sm_stop_preempts_the_robots_machine(node, robots):
     stop = node.advertise("/sm_stop", "std_msgs/msg/Empty")
     robot = robots()
-    wait_for(lambda: stop.subscribers() >= 1, 20, interval=0.02, what="the robot's subscription to /sm_stop")
+    wait_for(lambda: len(stop.subscribers) >= 1, 20, interval=0.02, what="the robot's subscription to /sm_stop")
     robot.wait_for_line("state: A 0")
     stop.publish({})
     robot.wait_for_line("outcome: preempted")

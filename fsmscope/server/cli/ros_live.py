@@ -33,7 +33,7 @@ def add_live_arguments(parser: argparse.ArgumentParser) -> None:
 
 def stop_topics(given: list[str]) -> Callable[[str], str]:
     """Each machine's stop topic, from ``--stop-topic`` values; ValueError for one that is not a ROS name."""
-    from fsmscope.interop.ros_controls import STOP_TOPIC
+    from fsmscope.interop.ros_watcher import STOP_TOPIC
 
     by_machine: dict[str, str] = {}
     default = STOP_TOPIC
@@ -72,7 +72,7 @@ def follow(node: Any, flavour: Flavour, hub: Hub | None, recorder: Recorder | No
             return
         entry.origin.robot = machine.publisher
         if not isinstance(entry.controls, RosControls):
-            entry.controls = RosControls(watcher, name, stop_topic(name))
+            entry.controls = RosControls(watcher, name)
             entry.origin.connected = machine.up
 
     def seen(name: str, up: bool) -> None:
@@ -96,7 +96,7 @@ def follow(node: Any, flavour: Flavour, hub: Hub | None, recorder: Recorder | No
             inbox.wake()
 
     try:
-        watcher = RosWatcher(node, flavour, deliver, seen_from_watcher)
+        watcher = RosWatcher(node, flavour, deliver, seen_from_watcher, stop_topic=stop_topic)
     except ValueError as exc:
         raise CannotServe(str(exc)) from None
     return watcher

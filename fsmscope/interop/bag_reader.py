@@ -11,6 +11,10 @@ topic's as recorded; ``smach_events.in_time_order`` merges them by stamp) as pla
 
 from __future__ import annotations
 
+import shutil
+import sqlite3
+import tempfile
+from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Iterator
@@ -61,10 +65,43 @@ def _server(topic: str) -> tuple[str, str] | None:
 
 
 def read_bag(path: str) -> Iterator[Message]:
-    """Every introspection message of the bag at ``path``, in time order. Raises ``BagError``."""
+    """Every introspection message of the bag at ``path``, and SMACH's lines of /rosout, in the bag's
+    order. Raises ``BagError``."""
     p = Path(path)
     if not p.exists():
         raise BagError("%s: no such file or folder" % path)
+    with tempfile.TemporaryDirectory(prefix="fsmscope-bag-") as folder:
+        yield from _read(path, _without_unknown_definitions(p, Path(folder)))
+
+
+def _without_unknown_definitions(p: Path, folder: Path) -> Path:
+    """The bag, or a copy of it in ``folder`` without the definitions a ROS 2 sqlite3 bag marks
+    ``unknown`` (rosbag2 writes that for a type it had no definition of, which rosbags cannot read:
+    without them it reads the types it knows, smach_msgs' and the Log's)."""
+    bag = p if p.is_dir() else p.parent
+    dbs = sorted(bag.glob("*.db3")) if (bag / "metadata.yaml").exists() and p.suffix != ".bag" else []
+    try:
+        if not any(_unknown_definitions(db) for db in dbs):
+            return p
+        copy = folder / bag.name
+        shutil.copytree(bag, copy)
+        for db in sorted(copy.glob("*.db3")):
+            with closing(sqlite3.connect(db)) as con, con:
+                con.execute("DELETE FROM message_definitions WHERE encoding = 'unknown'")
+        return copy if p.is_dir() else copy / p.name
+    except (OSError, sqlite3.Error):  # rosbags then says what is wrong with it
+        return p
+
+
+def _unknown_definitions(db: Path) -> bool:
+    with closing(sqlite3.connect("file:%s?mode=ro" % db, uri=True)) as con:
+        try:
+            return con.execute("SELECT 1 FROM message_definitions WHERE encoding = 'unknown' LIMIT 1").fetchone() is not None
+        except sqlite3.OperationalError:  # an older bag: no such table
+            return False
+
+
+def _read(path: str, p: Path) -> Iterator[Message]:
     ros2 = p.suffix != ".bag"
     try:
         reader = AnyReader([p], default_typestore=smach_msgs.typestore(ros2=True) if ros2 else None)

@@ -44,8 +44,25 @@ class Ros1(ros1.Ros1):
 
     def robot(self, script: str, *args: str) -> Robot:
         """``python tests/robots/SCRIPT ARGS...`` as a node of this master."""
-        return Robot([sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args],
-                     self.robot_env(), self.home)
+        return Robot(self.robot_argv(script, *args), self.robot_env(), self.home)
+
+    def robot_argv(self, script: str, *args: str) -> list[str]:
+        return [sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args]
+
+    def recorded(self, bag: Path, script: str, *args: str, timeout: float = 120) -> str:
+        """``python tests/robots/SCRIPT ARGS...`` run to its end while the real ``rosbag record -a``
+        records this master's topics into ``bag``; what the robot printed."""
+        recorder = subprocess.Popen(["rosbag", "record", "-a", "-O", str(bag)], env=self.ros_env(), cwd=self.home,
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                    start_new_session=True)
+        try:
+            robot = subprocess.run(self.robot_argv(script, *args), env=self.robot_env(), cwd=self.home,
+                                   capture_output=True, text=True, timeout=timeout)
+        finally:
+            interrupt(recorder, 20)  # rosbag closes the bag on SIGINT, as on Ctrl-C
+        said = recorder.stdout.read()
+        assert robot.returncode == 0 and bag.exists(), robot.stdout + robot.stderr + said
+        return robot.stdout
 
 
 class Robot:

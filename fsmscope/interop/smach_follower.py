@@ -323,14 +323,22 @@ class Follower:
         above = parent(path)
         return path not in self.active and (path == self.tree.root or label(path) in self.active.get(above, ()))
 
+    def _of_kind(self, kind: str, fits: Callable[[str], bool]) -> str | None:
+        """The one container of ``kind`` that ``fits``, else the one whose class nothing told yet that
+        could be of that kind (a Concurrence has several children, an Iterator one)."""
+        def could(p: str) -> bool:
+            n = len(self.tree.children(p))
+            return p not in self.tree.kinds and (n > 1 if kind == CONCURRENCE else n == 1)
+        return self._one(lambda p: self.tree.kinds.get(p) == kind and fits(p)) or self._one(lambda p: could(p) and fits(p))
+
     def _start_told(self, kind: str, initial: str | None, keys: list[str]) -> None:
-        def fits(p: str) -> bool:
-            if kind == MACHINE:
-                return self.tree.kind(p) == MACHINE and initial in self.tree.children(p)
-            return self.tree.kinds.get(p) == CONCURRENCE or (p not in self.tree.kinds and len(self.tree.children(p)) > 1)
-        if initial is not None and self._one(lambda p: fits(p) and self.active.get(p) == [initial]):
-            return  # a status showed it start first
-        path = self._one(lambda p: fits(p) and self._enterable(p))
+        if kind == MACHINE:
+            if self._one(lambda p: self.tree.kind(p) == MACHINE and self.active.get(p) == [initial]):
+                return  # a status showed it start first
+            path = self._one(lambda p: self.tree.kind(p) == MACHINE and initial in self.tree.children(p)
+                             and self._enterable(p))
+        else:
+            path = self._of_kind(CONCURRENCE, self._enterable)
         if path is None:
             return
         self.tree.told(path, kind)
@@ -340,9 +348,7 @@ class Follower:
         self._start(path, states, states, data)
 
     def _iterating(self, said: smach_lines.Said) -> None:
-        def fits(p: str) -> bool:
-            return self.tree.kinds.get(p, ITERATOR) == ITERATOR and len(self.tree.children(p)) == 1
-        path = self._one(lambda p: fits(p) and p in self.active) or self._one(lambda p: fits(p) and self._enterable(p))
+        path = self._of_kind(ITERATOR, lambda p: p in self.active) or self._of_kind(ITERATOR, self._enterable)
         if path is None:
             return
         self.tree.told(path, ITERATOR)
@@ -360,7 +366,7 @@ class Follower:
             if seen is not None and self.inferred.get(seen) == (source, target):  # its status came first
                 self.pending[seen] = self.pending.get(seen, 0) + 1
                 return
-            path = self._one(lambda p: fits(p) and source in self.tree.children(p) and p not in self.active)
+            path = self._one(lambda p: fits(p) and source in self.tree.children(p) and self._enterable(p))
             if path is None:
                 return
             self._start(path, self.tree.initial.get(path) or [source], [source], self.userdata.get(path, {}))

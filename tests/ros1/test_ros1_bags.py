@@ -123,3 +123,16 @@ def test_without_rosout_no_outcome_is_invented_and_an_untold_end_exits_1(recorde
     done = cli("replay", bag, "--no-transcript")
     assert done.returncode == 1, done.stdout + done.stderr
     assert "machine jam: the end of its last run is not in the bag" in done.stderr
+
+
+def test_a_recorder_that_joined_late_tells_only_transitions_the_machine_has(recorded, tmp_path):
+    grasped = next(e["t"] for e in recorded.truth if e["kind"] == "transition" and e.get("to") == "PAR")
+    bag = rewrite(recorded.bag, tmp_path / "late.bag", "ros1", since=grasped + 0.1)
+    events = [e for e in imported(bag) if e["machine"] == "pick"]
+    edges = {(e["path"], e["from"], e["outcome"], e["to"]) for e in recorded.truth
+             if e["kind"] == "transition" and e["machine"] == "pick"}
+    told = [(e["path"], e["from"], e["outcome"], e["to"]) for e in events if e["kind"] == "transition"]
+    assert told and set(told) <= edges
+    start = next(e for e in events if e["kind"] == "start")
+    assert (start["path"], start["active"]) == ("/SM_ROOT", ["PAR"])
+    assert (events[-1]["kind"], events[-1]["path"], events[-1]["outcome"]) == ("terminate", "/SM_ROOT", "done")

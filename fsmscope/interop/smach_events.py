@@ -70,8 +70,9 @@ def events(messages: Iterable[Message], refused: Callable[[str], None] | None = 
                 f = followers[m.server] = Follower(m.server, names.unique(m.server, taken))
                 taken.add(f.name)
                 nodes.setdefault(m.node, []).append(f)
-                for line in orphans.get(m.node, ()) if m.node is not None else itertools.chain(*orphans.values()):
-                    emit(f.feed(line))
+                lines = orphans.get(m.node, ()) if m.node is not None else itertools.chain(*orphans.values())
+                for line in sorted((line for line in lines if line.t >= m.t - WAIT), key=lambda line: line.t):
+                    emit(f.feed(line))  # its node's lines logged just before the server's first message
             emit(f.feed(m))
         while out and out[0][0] < m.t - WAIT - WINDOW:
             yield heapq.heappop(out)[2]

@@ -29,7 +29,8 @@ _TOLD = {
 }
 # SMACH's other lines (said as ``log`` events of the machine, as fsm's watcher sends them).
 _OTHER = ("Preempt requested on state machine before executing the next state.", "Last state '",
-          "State '", "Could not execute ", "Container consistency check failed.", "Attempting to ",
+          "State '", "Could not execute ", "Container consistency check failed.", "Attempting to copy ",
+          "Attempting to get state '", "Attempting to set initial state", "Attempting to set state '",
           "Outcome callback returned ", "Userdata key '", "Reading from SMACH userdata key '",
           "Writing to SMACH userdata key '", "InvalidStateError: ", "InvalidTransitionError: ",
           "InvalidUserCodeError: ", "Both loop_outcomes and break_outcomes ", "Error raised during SMACH container")

@@ -86,9 +86,11 @@ def wide_run(children: int) -> list:
 ROS2_LEVELS = {1: 10, 2: 20, 4: 30, 8: 40, 16: 50}  # rosgraph_msgs/Log's levels as rcl_interfaces/msg/Log's
 
 
-def rewrite(recorded: Path, out: Path, layout: str, rosout: bool = True, since: float = 0.0) -> Path:
+def rewrite(recorded: Path, out: Path, layout: str, rosout: bool = True, since: float = 0.0,
+            until: float | None = None) -> Path:
     """The messages of a ROS 1 bag ``recorded`` (smach_ros's introspection, /rosout) written again at
-    ``out``, those recorded from ``since`` (seconds, the bag's time: a recorder that joined then):
+    ``out``, those recorded from ``since`` to ``until`` (seconds, the bag's time: a recorder that joined
+    late, or stopped early):
     ``layout`` "ros1" (the same connections and bytes; without /rosout unless ``rosout``), or
     "ros2-sqlite3" / "ros2-mcap" as a ROS 2 robot publishes them (``local_data`` the raw pickle, the
     Log as rcl_interfaces', the node's name without its slash)."""
@@ -101,7 +103,8 @@ def rewrite(recorded: Path, out: Path, layout: str, rosout: bool = True, since: 
             with Writer1(out) as writer:
                 made = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, md5sum=c.digest,
                                                     callerid=c.ext.callerid, latching=c.ext.latching) for c in wanted}
-                for c, t, raw in reader.messages(connections=wanted, start=int(since * 1e9)):
+                for c, t, raw in reader.messages(connections=wanted, start=int(since * 1e9),
+                                                 stop=None if until is None else int(until * 1e9)):
                     writer.write(made[c.id], t, raw)
             return out
         store = smach_msgs.typestore(ros2=True)

@@ -136,3 +136,11 @@ def test_a_recorder_that_joined_late_tells_only_transitions_the_machine_has(reco
     start = next(e for e in events if e["kind"] == "start")
     assert (start["path"], start["active"]) == ("/SM_ROOT", ["PAR"])
     assert (events[-1]["kind"], events[-1]["path"], events[-1]["outcome"]) == ("terminate", "/SM_ROOT", "done")
+
+
+def test_a_recorder_stopped_right_after_the_run_knows_its_end_from_rosout(recorded, tmp_path):
+    ended = next(e["t"] for e in recorded.truth if e["kind"] == "terminate" and e["machine"] == "pick"
+                 and e["path"] == "/SM_ROOT")
+    bag = rewrite(recorded.bag, tmp_path / "stopped.bag", "ros1", until=ended + 0.1)
+    done = cli("replay", bag, "--no-transcript")
+    assert "machine pick: finished with outcome 'done'" in done.stdout, done.stdout + done.stderr

@@ -49,7 +49,7 @@ class Follower:
         self.inferred: dict[str, tuple[str, str]] = {}  # the last transition a status showed, per container
         self.returned: dict[str, dict[str, str]] = {}  # a running Concurrence's children's told outcomes
         self.closing: dict[str, dict[str, str]] = {}  # Concurrences whose end a line told, outcome untold yet
-        self.seen_idle: set[str] = set()
+        self.fresh: set[str] = set()  # containers seen idle, or just entered: a run of theirs starts at the start
         self.seq = self.runs = 0
         self.run: str | None = None
         self.t = 0.0
@@ -143,7 +143,7 @@ class Follower:
             if active:
                 self._start_seen(path, f["initial_states"], active, data)
             else:
-                self.seen_idle.add(path)
+                self.fresh.add(path)
                 self._userdata(path, data)
             return
         self._userdata(path, data)
@@ -171,14 +171,15 @@ class Follower:
     def _start_seen(self, path: str, initial: list[str], active: list[str], data: dict) -> None:
         """A container a status shows running: a Concurrence with all its children (the others
         returned, what nothing told); a StateMachine from its initial state when that is where it
-        is, or when it was seen idle and one edge leads from there to where it is; else where it is."""
+        is, or when it was seen idle or entered and one edge leads from there to where it is; else
+        where it is (a recorder that joined late knows nothing of how it got there)."""
         initial = [s for s in initial if s != NONE] or active
         if self.tree.kind(path) == CONCURRENCE:
             self._start(path, initial, initial, data)
             self._concurrence_seen(path, active)
             return
         step = UNKNOWN
-        if path in self.seen_idle and active != initial:
+        if path in self.fresh and active != initial:
             step = self.tree.step(path, initial[0], active[0])
         if active == initial or step != UNKNOWN:
             self._start(path, initial, initial, data)
@@ -213,6 +214,9 @@ class Follower:
         self.userdata[path] = data
         self.returned[path] = {}
         self.pending.pop(path, None)
+        self.fresh.discard(path)
+        if active == initial:
+            self.fresh.update(path + "/" + s for s in active)
         self._event(build.start, path, list(initial), list(active), data)
 
     def _move(self, path: str, target: str, outcome: str | None) -> None:
@@ -224,6 +228,7 @@ class Follower:
         told = outcome if outcome is not None else self.tree.step(path, source, target)
         outcome = self._leave(path, source, told)
         self.active[path] = [target]
+        self.fresh.add(path + "/" + target)
         self._event(build.transition, path, source, outcome, target, [target])
 
     def _leave(self, path: str, state: str, outcome: str) -> str:
@@ -269,6 +274,7 @@ class Follower:
                         schema.ABSENT if state_outcome is None else state_outcome)
         self.ended[path] = outcome
         self.returned.pop(path, None)
+        self.fresh.add(path)
         if path == self.tree.root:
             self.finished = outcome != UNKNOWN
         above = parent(path)

@@ -94,11 +94,12 @@ def _without_unknown_definitions(p: Path, folder: Path) -> Path:
 
 
 def _unknown_definitions(db: Path) -> bool:
-    with closing(sqlite3.connect("file:%s?mode=ro" % db, uri=True)) as con:
+    with closing(sqlite3.connect(db.resolve().as_uri() + "?mode=ro", uri=True)) as con:
         try:
-            return con.execute("SELECT 1 FROM message_definitions WHERE encoding = 'unknown' LIMIT 1").fetchone() is not None
+            found = con.execute("SELECT 1 FROM message_definitions WHERE encoding = 'unknown' LIMIT 1").fetchone()
         except sqlite3.OperationalError:  # an older bag: no such table
             return False
+        return found is not None
 
 
 def _read(path: str, p: Path) -> Iterator[Message]:

@@ -335,7 +335,8 @@ class Follower:
         def could(p: str) -> bool:
             n = len(self.tree.children(p))
             return p not in self.tree.kinds and (n > 1 if kind == CONCURRENCE else n == 1)
-        return self._one(lambda p: self.tree.kinds.get(p) == kind and fits(p)) or self._one(lambda p: could(p) and fits(p))
+        told = self._one(lambda p: self.tree.kinds.get(p) == kind and fits(p))
+        return told or self._one(lambda p: could(p) and fits(p))
 
     def _start_told(self, kind: str, initial: str | None, keys: list[str]) -> None:
         if kind == MACHINE:

@@ -78,7 +78,8 @@ def keys(listed: str) -> list[str]:
 
 def outcomes(listed: str) -> dict[str, str | None] | None:
     """``{'A': 'done', 'B': None}`` read from the inside of the braces; None if it is not that form."""
-    found = {_unquoted(m.group(1)): None if m.group(2) == "None" else _unquoted(m.group(3)) for m in _ITEM.finditer(listed)}
+    found = {_unquoted(m.group(1)): None if m.group(2) == "None" else _unquoted(m.group(3))
+             for m in _ITEM.finditer(listed)}
     rebuilt = ", ".join("%r: %r" % item for item in found.items())
     return found if rebuilt == listed or not listed else None
 

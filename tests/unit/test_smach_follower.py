@@ -93,7 +93,8 @@ def test_the_one_place_a_last_state_leads_out_to_is_the_machines_outcome_whateve
 
 def test_a_line_says_the_outcome_a_status_cannot():
     two_ways = PATROL + [("slept", "RECOVER", "WORK")]
-    messages = [structure(0, ROOT, ["INIT", "WORK", "RECOVER"], two_ways, ["done"]), status(0.6, ROOT, ["INIT"], ["None"]),
+    messages = [structure(0, ROOT, ["INIT", "WORK", "RECOVER"], two_ways, ["done"]),
+                status(0.6, ROOT, ["INIT"], ["None"]),
                 status(1, ROOT, ["INIT"], ["RECOVER"]), status(2, ROOT, ["INIT"], ["WORK"], STEP)]
     assert told(messages)[-1] == ("transition", ROOT, "RECOVER", "?", "WORK")
     messages.insert(3, line(1.99, "State machine transitioning 'RECOVER':'slept'-->'WORK'"))
@@ -101,7 +102,8 @@ def test_a_line_says_the_outcome_a_status_cannot():
 
 
 def test_a_line_of_another_node_says_nothing_of_this_servers_machine():
-    messages = [structure(0, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]), status(0.6, ROOT, ["INIT"], ["None"]),
+    messages = [structure(0, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]),
+                status(0.6, ROOT, ["INIT"], ["None"]),
                 line(1, "State machine starting in initial state 'INIT' with userdata: \n\t[]", node="/other"),
                 status(1.5, ROOT, ["INIT"], ["None"])]
     assert [ev["kind"] for ev in smach_events.events(messages)] == ["structure"]

@@ -342,7 +342,7 @@ class Follower:
         if kind == MACHINE:
             if self._one(lambda p: self.tree.kind(p) == MACHINE and self.active.get(p) == [initial]):
                 return  # a status showed it start first
-            path = self._one(lambda p: self.tree.kind(p) == MACHINE and initial in self.tree.children(p)
+            path = self._one(lambda p: self.tree.kind(p) == MACHINE and self.tree.has(p, initial)
                              and self._enterable(p))
         else:
             path = self._of_kind(CONCURRENCE, self._enterable)
@@ -366,14 +366,14 @@ class Follower:
 
     def _transition_told(self, source: str, outcome: str, target: str) -> None:
         def fits(p: str) -> bool:
-            return self.tree.kind(p) == MACHINE and target in self.tree.children(p)
+            return self.tree.kind(p) == MACHINE and self.tree.has(p, target)
         path = self._one(lambda p: fits(p) and self.active.get(p) == [source])
         if path is None:
             seen = self._one(lambda p: fits(p) and self.active.get(p) == [target])
             if seen is not None and self.inferred.get(seen) == (source, target):  # its status came first
                 self.pending[seen] = self.pending.get(seen, 0) + 1
                 return
-            path = self._one(lambda p: fits(p) and source in self.tree.children(p) and self._enterable(p))
+            path = self._one(lambda p: fits(p) and self.tree.has(p, source) and self._enterable(p))
             if path is None:
                 return
             self._start(path, self.tree.initial.get(path) or [source], [source], self.userdata.get(path, {}))

@@ -41,6 +41,7 @@ class Tree:
         self.paths: set[str] = set()
         self.version = 0
         self._leaving: dict[str, dict[str, list[dict]]] = {}
+        self._labels: dict[str, frozenset[str]] = {}
 
     # What the messages tell.
     def structure(self, f: dict) -> None:
@@ -75,6 +76,7 @@ class Tree:
             self._changed(path)
 
     def _changed(self, path: str) -> None:
+        self._labels.pop(path, None)
         self.paths.add(path)
         self.version += 1
 
@@ -90,6 +92,13 @@ class Tree:
     def children(self, path: str) -> list[str]:
         s = self.structures.get(path)
         return list(s["children"]) if s else list(self.named.get(path, {}))
+
+    def has(self, path: str, state: str) -> bool:
+        """Whether ``state`` is a child of the container at ``path`` (a set made once per change)."""
+        labels = self._labels.get(path)
+        if labels is None:
+            labels = self._labels[path] = frozenset(self.children(path))
+        return state in labels
 
     def outcomes(self, path: str) -> list[str]:
         s = self.structures.get(path)
@@ -138,11 +147,11 @@ class Tree:
         among the edges from ``last`` decides the first, a unique edge the second; else UNKNOWN, None."""
         if self.kind(path) == CONCURRENCE:
             return UNKNOWN, None
-        outcomes, children = self.outcomes(path), set(self.children(path))
+        outcomes = self.outcomes(path)
         ends = set()
         for e in self.leaving(path, last):  # SMACH's rule: a target that is no state nor outcome falls through
             place = e["to"] if e["to"] in outcomes else e["outcome"]
-            if e["to"] not in children and place in outcomes and returned in (None, e["outcome"]):
+            if not self.has(path, e["to"]) and place in outcomes and returned in (None, e["outcome"]):
                 ends.add((place, e["outcome"]))
         places = {place for place, _ in ends}
         if len(places) != 1:

@@ -49,6 +49,7 @@ class Follower:
         self.inferred: dict[str, tuple[str, str]] = {}  # the last transition a status showed, per container
         self.returned: dict[str, dict[str, str]] = {}  # a running Concurrence's children's told outcomes
         self.closing: dict[str, dict[str, str]] = {}  # Concurrences whose end a line told, outcome untold yet
+        self.lines = False  # whether SMACH's lines tell this machine
         self.fresh: set[str] = set()  # containers seen idle, or just entered: a run of theirs starts at the start
         self.seq = self.runs = 0
         self.run: str | None = None
@@ -119,8 +120,6 @@ class Follower:
             said = smach_lines.read(m.fields["msg"], m.fields["level"])
             if said is not None:
                 self._line(said)
-        if self.tree.version != self.described:  # a line told a container's class
-            self._describe()
 
     def _event(self, make: Callable[..., dict], path: str, *fields: Any) -> None:
         """The next event, made by the schema's maker of its kind (``schema.build``)."""
@@ -194,6 +193,8 @@ class Follower:
             self._terminate(path, None)
             self._start(path, self.tree.children(path), active, self.userdata.get(path, {}))
             return
+        if self.lines:  # a child's own line tells it returned (a status may show it before: children run at once)
+            return
         for child in [s for s in running if s not in active]:
             self._child_returned(path, child, self.returned.get(path, {}).get(child))
 
@@ -266,10 +267,9 @@ class Follower:
             last = running or (self.tree.children(path)[:1] if kind == ITERATOR else [])
             returned = state_outcome or (self.ended.get(path + "/" + last[0]) if last else None)
             returned = None if returned == UNKNOWN else returned
-            if outcome is None and last:
-                outcome, state_outcome = self.tree.end(path, last[0], returned)
+            if last:
+                outcome, state_outcome = self.tree.end(path, last[0], returned, outcome)
             outcome = outcome or UNKNOWN
-            state_outcome = state_outcome or returned
             self._event(build.terminate, path, last, outcome, [],
                         schema.ABSENT if state_outcome is None else state_outcome)
         self.ended[path] = outcome
@@ -294,6 +294,11 @@ class Follower:
 
     # What a line says.
     def _line(self, said: smach_lines.Said) -> None:
+        before = self.seq
+        self._said(said)
+        self.lines = self.lines or (said.kind != "other" and self.seq != before)
+
+    def _said(self, said: smach_lines.Said) -> None:
         kind, v = said.kind, said.values
         if kind == "start":
             self._start_told(MACHINE, v[0], v[1])
@@ -312,12 +317,19 @@ class Follower:
         elif kind == "outcomes":
             self._outcomes_told(v[0])
         elif kind == "serviced":
-            path = self._one(lambda p: self.tree.kind(p) == CONCURRENCE and p in self.active and p not in self.closing)
+            path = self._one(lambda p: self.tree.kind(p) == CONCURRENCE and self.active.get(p) == []
+                             and p not in self.closing)  # its children all returned (preempted) before
             if path is not None:
                 self._event(build.log, path, said.level, said.text)
                 self._terminate(path, "preempted")
         elif not quiet(said.level, said.text) and self.active:
             self._event(build.log, max(self.active, key=len), said.level, said.text)
+
+    def _told(self, path: str, kind: str) -> None:
+        """A line told the container's class: the tree is described again before its events."""
+        self.tree.told(path, kind)
+        if self.tree.version != self.described:
+            self._describe()
 
     def _one(self, fits: Callable[[str], bool]) -> str | None:
         """The one container that ``fits``; None when none or several do (the line is then left untold)."""
@@ -348,7 +360,7 @@ class Follower:
             path = self._of_kind(CONCURRENCE, self._enterable)
         if path is None:
             return
-        self.tree.told(path, kind)
+        self._told(path, kind)
         above, own = self.userdata.get(parent(path), {}), self.userdata.get(path, {})
         data = {k: above[k] if k in above else own.get(k, UNTOLD) for k in keys}  # input keys: the parent's
         states = [initial] if initial is not None else self.tree.children(path)
@@ -358,7 +370,7 @@ class Follower:
         path = self._of_kind(ITERATOR, lambda p: p in self.active) or self._of_kind(ITERATOR, self._enterable)
         if path is None:
             return
-        self.tree.told(path, ITERATOR)
+        self._told(path, ITERATOR)
         if path not in self.active:
             body = self.tree.children(path)
             self._start(path, body, body, self.userdata.get(path, {}))

@@ -141,19 +141,20 @@ class Tree:
         found = {e["outcome"] for e in self.leaving(path, source) if e["to"] == target}
         return found.pop() if len(found) == 1 else UNKNOWN
 
-    def end(self, path: str, last: str, returned: str | None) -> tuple[str, str | None]:
+    def end(self, path: str, last: str, returned: str | None, outcome: str | None = None) -> tuple[str, str]:
         """(the container's outcome, what its last state returned) when the container ended after
-        ``last`` (which ``returned`` its outcome, when known): a unique place out of the container
-        among the edges from ``last`` decides the first, a unique edge the second; else UNKNOWN, None."""
+        ``last`` (which ``returned`` its outcome, and the container ended with ``outcome``, when
+        known): a unique place out of the container among the edges from ``last`` decides the
+        first, a unique edge the second; else UNKNOWN."""
         if self.kind(path) == CONCURRENCE:
-            return UNKNOWN, None
+            return outcome or UNKNOWN, returned or UNKNOWN
         outcomes = self.outcomes(path)
         ends = set()
         for e in self.leaving(path, last):  # SMACH's rule: a target that is no state nor outcome falls through
             place = e["to"] if e["to"] in outcomes else e["outcome"]
-            if not self.has(path, e["to"]) and place in outcomes and returned in (None, e["outcome"]):
+            if (not self.has(path, e["to"]) and place in outcomes and returned in (None, e["outcome"])
+                    and outcome in (None, place)):
                 ends.add((place, e["outcome"]))
         places = {place for place, _ in ends}
-        if len(places) != 1:
-            return UNKNOWN, returned
-        return places.pop(), ends.pop()[1] if len(ends) == 1 else returned
+        place = places.pop() if len(places) == 1 else UNKNOWN
+        return outcome or place, returned or (ends.pop()[1] if len(ends) == 1 else UNKNOWN)

@@ -13,8 +13,11 @@ jam       PICK: a Concurrence of ARM ('reached') and GRIPPER (a StateMachine who
           'jammed'); no outcome_map entry holds, so PICK ends 'failed' (its default), the root 'aborted'.
 count     COUNT: an Iterator over [10, 20, 30] of BODY (a StateMachine whose ADD adds the item to
           'total': 0 -> 10 -> 30 -> 60, 'continue' loops), exhausted 'counted'; root 'counted'.
+stop      WAIT: a Concurrence of LEFT and RIGHT (each waits until preempted); the robot preempts the
+          machine 1 s in: both return 'preempted', WAIT services the preempt, the root ends 'preempted'.
 """
 import sys
+import threading
 import time
 
 import fsm
@@ -36,6 +39,17 @@ class Step(smach.State):
     def execute(self, ud):
         rospy.sleep(PAUSE)
         return self.returns.pop(0) if len(self.returns) > 1 else self.returns[0]
+
+
+class Waiting(smach.State):
+    def __init__(self):
+        smach.State.__init__(self, ["waited", "preempted"])
+
+    def execute(self, ud):
+        while not self.preempt_requested():
+            rospy.sleep(0.02)
+        self.service_preempt()
+        return "preempted"
 
 
 class Add(smach.State):
@@ -99,7 +113,19 @@ def count():
     return root
 
 
-MACHINES = {"pick": pick, "jam": jam, "count": count}
+def stop():
+    wait = smach.Concurrence(outcomes=["waited", "preempted"], default_outcome="waited")
+    with wait:
+        smach.Concurrence.add("LEFT", Waiting())
+        smach.Concurrence.add("RIGHT", Waiting())
+    root = smach.StateMachine(outcomes=["done", "preempted"])
+    with root:
+        smach.StateMachine.add("WAIT", wait, {"waited": "done"})
+    root.register_start_cb(lambda ud, states: threading.Timer(1.0, root.request_preempt).start())
+    return root
+
+
+MACHINES = {"pick": pick, "jam": jam, "count": count, "stop": stop}
 
 
 def subscribed(server):

@@ -21,7 +21,7 @@ from fsmscope.interop import bag_reader, smach_events
 from fsmscope.interop.testing import rewrite
 from recording_support import cli
 
-MACHINES = ("pick", "jam", "count")
+MACHINES = ("pick", "jam", "count", "stop")
 
 
 @dataclass
@@ -145,3 +145,10 @@ def test_a_recorder_stopped_right_after_the_run_knows_its_end_from_rosout(record
     bag = rewrite(recorded.bag, tmp_path / "stopped.bag", "ros1", until=ended + 0.1)
     done = cli("replay", bag, "--no-transcript")
     assert "machine pick: finished with outcome 'done'" in done.stdout, done.stdout + done.stderr
+
+
+def test_a_concurrence_that_services_a_preempt_ends_preempted(recorded):
+    stop = lines(imported(recorded.bag))["stop"]
+    assert stop[-2:] == [("info", "Concurrence serviced preempt."),
+                         ("info", "State machine terminating 'WAIT':'preempted':'preempted'")]
+    assert not any(text.startswith("Concurrent Outcomes") for _, text in stop)

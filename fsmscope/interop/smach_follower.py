@@ -336,10 +336,10 @@ class Follower:
         found = [p for p in self.tree.paths if fits(p)]
         return found[0] if len(found) == 1 else None
 
-    def _enterable(self, path: str) -> bool:
-        """Not running, and the root or a state its running parent is in."""
+    def _enterable(self, path: str, again: bool = False) -> bool:
+        """Not running (or, ``again``, running), and the root or a state its running parent is in."""
         above = parent(path)
-        return path not in self.active and (path == self.tree.root or label(path) in self.active.get(above, ()))
+        return (path in self.active) == again and (path == self.tree.root or label(path) in self.active.get(above, ()))
 
     def _of_kind(self, kind: str, fits: Callable[[str], bool]) -> str | None:
         """The one container of ``kind`` that ``fits``, else the one whose class nothing told yet that
@@ -354,8 +354,13 @@ class Follower:
         if kind == MACHINE:
             if self._one(lambda p: self.tree.kind(p) == MACHINE and self.active.get(p) == [initial]):
                 return  # a status showed it start first
-            path = self._one(lambda p: self.tree.kind(p) == MACHINE and self.tree.has(p, initial)
-                             and self._enterable(p))
+            def fits(p: str) -> bool:
+                return self.tree.kind(p) == MACHINE and self.tree.has(p, initial)
+            path = self._one(lambda p: fits(p) and self._enterable(p))
+            again = path or self._one(lambda p: fits(p) and self._enterable(p, again=True))
+            if path is None and again is not None:  # it runs again, its last run's end untold
+                self._terminate(again, None)
+                path = again
         else:
             path = self._of_kind(CONCURRENCE, self._enterable)
         if path is None:

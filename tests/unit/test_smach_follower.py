@@ -140,3 +140,13 @@ def test_a_bag_whose_run_ends_untold_replays_as_unfinished(tmp_path):
     done = cli("replay", write_bag(tmp_path / "untold.bag", "ros1", runs), "--no-time")
     assert "State machine terminating 'RECOVER':'?':'?'" in done.stdout
     assert done.returncode == 1 and "machine robot: the end of its last run is not in the bag" in done.stderr
+
+
+def test_a_machine_that_starts_again_before_its_end_was_told_ends_untold_first():
+    assert told([structure(0, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]),
+                 status(0.6, ROOT, ["INIT"], ["None"]),
+                 line(1, "State machine starting in initial state 'INIT' with userdata: \n\t[]"),
+                 line(2, "State machine transitioning 'INIT':'go'-->'WORK'"),
+                 line(5, "State machine starting in initial state 'INIT' with userdata: \n\t[]")]) == [
+        ("start", ROOT, None, None, None), ("transition", ROOT, "INIT", "go", "WORK"),
+        ("terminate", ROOT, None, "?", None), ("start", ROOT, None, None, None)]

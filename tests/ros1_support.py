@@ -50,8 +50,25 @@ class Ros1(ros1.Ros1):
     def robot(self, script: str, *args: str, ready: str = DASHBOARD_LINE) -> Robot:
         """``python tests/robots/SCRIPT ARGS...`` as a node of this master, once it printed a line that
         matches ``ready``."""
-        return Robot([sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args],
-                     self.robot_env(), self.home, ready)
+        return Robot(self.robot_argv(script, *args), self.robot_env(), self.home, ready)
+
+    def robot_argv(self, script: str, *args: str) -> list[str]:
+        return [sys.executable, "-c", _WITH_DEBIAN_PACKAGES_LAST, str(ROBOTS / script), *args]
+
+    def recorded(self, bag: Path, script: str, *args: str, timeout: float = 120) -> str:
+        """``python tests/robots/SCRIPT ARGS...`` run to its end while the real ``rosbag record -a``
+        records this master's topics into ``bag``; what the robot printed."""
+        recorder = subprocess.Popen(["rosbag", "record", "-a", "-O", str(bag)], env=self.ros_env(), cwd=self.home,
+                                    stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                                    start_new_session=True)
+        try:
+            robot = subprocess.run(self.robot_argv(script, *args), env=self.robot_env(), cwd=self.home,
+                                   capture_output=True, text=True, timeout=timeout)
+        finally:
+            interrupt(recorder, 20)  # rosbag closes the bag on SIGINT, as on Ctrl-C
+        said = recorder.stdout.read()
+        assert robot.returncode == 0 and bag.exists(), robot.stdout + robot.stderr + said
+        return robot.stdout
 
 
 class Robot:
@@ -140,7 +157,7 @@ def two_robots(ros: Ros1) -> Iterator[dict[str, Robot]]:
     """Robots nobody may change (tests/robots/smach_ros_robot.py): r1 (node /robot1, server /r1, stop
     topic /r1/sm_stop) and r2 (node /robot2, ...), by their machines' names; the dict may be given
     new robots, which are stopped too."""
-    robots = {name: ros.robot("smach_ros_robot.py", node, "/" + name, "/%s/sm_stop" % name, ready=READY)
+    robots = {name: ros.robot("smach_ros_loop.py", node, "/" + name, "/%s/sm_stop" % name, ready=READY)
               for name, node in (("r1", "robot1"), ("r2", "robot2"))}
     try:
         yield robots

@@ -11,7 +11,7 @@ import numpy
 from rosbags.rosbag1 import Writer as Writer1
 from rosbags.rosbag2 import StoragePlugin, Writer as Writer2
 
-from . import smach_msgs
+from . import bag_reader, smach_msgs
 
 
 def _message(store, kind: str, fields: dict, t: float, ros2: bool, raw_pickle: bool):
@@ -81,3 +81,56 @@ def wide_run(children: int) -> list:
     return container_run("wide", {"/ROOT": (labels, edges, ["done"])},
                          [(0.0, "/ROOT", ["S0"], ["S0"], {}), (1.0, "/ROOT", ["S0"], ["S1"], {}),
                           (2.0, "/ROOT", ["S0"], ["None"], {})])
+
+
+ROS2_LEVELS = {1: 10, 2: 20, 4: 30, 8: 40, 16: 50}  # rosgraph_msgs/Log's levels as rcl_interfaces/msg/Log's
+
+
+def rewrite(recorded: Path, out: Path, layout: str, rosout: bool = True, since: float = 0.0,
+            until: float | None = None) -> Path:
+    """The messages of a ROS 1 bag ``recorded`` (smach_ros's introspection, /rosout) written again at
+    ``out``, those recorded from ``since`` to ``until`` (seconds, the bag's time: a recorder that joined
+    late, or stopped early):
+    ``layout`` "ros1" (the same connections and bytes; without /rosout unless ``rosout``), or
+    "ros2-sqlite3" / "ros2-mcap" as a ROS 2 robot publishes them (``local_data`` the raw pickle, the
+    Log as rcl_interfaces', the node's name without its slash)."""
+    from rosbags.highlevel import AnyReader
+
+    kept = smach_msgs.STRUCTURE, smach_msgs.STATUS, "rosgraph_msgs/msg/Log"
+    with AnyReader([recorded]) as reader:
+        wanted = [c for c in reader.connections if c.msgtype in kept[:2] or (rosout and c.msgtype == kept[2])]
+        if layout == "ros1":
+            with Writer1(out) as writer:
+                made = {c.id: writer.add_connection(c.topic, c.msgtype, msgdef=c.msgdef.data, md5sum=c.digest,
+                                                    callerid=c.ext.callerid, latching=c.ext.latching) for c in wanted}
+                for c, t, raw in reader.messages(connections=wanted, start=int(since * 1e9),
+                                                 stop=None if until is None else int(until * 1e9)):
+                    writer.write(made[c.id], t, raw)
+            return out
+        store = smach_msgs.typestore(ros2=True)
+        plugin = StoragePlugin.MCAP if layout == "ros2-mcap" else StoragePlugin.SQLITE3
+        with Writer2(out, version=8, storage_plugin=plugin) as writer:
+            made = {}
+            for c, t, raw in reader.messages(connections=wanted):
+                msgtype = "rcl_interfaces/msg/Log" if c.msgtype == kept[2] else c.msgtype
+                if c.topic not in made:
+                    made[c.topic] = writer.add_connection(c.topic, msgtype, typestore=store)
+                msg = _ros2(store, reader.deserialize(raw, c.msgtype), c.msgtype)
+                writer.write(made[c.topic], t, store.serialize_cdr(msg, msgtype))
+    return out
+
+
+def _ros2(store, msg, msgtype: str):
+    """A ROS 1 message (smach_msgs', a Log) as its ROS 2 counterpart."""
+    Time = store.types["builtin_interfaces/msg/Time"]
+    stamp = Time(sec=msg.header.stamp.sec, nanosec=msg.header.stamp.nanosec)
+    if msgtype == "rosgraph_msgs/msg/Log":
+        return store.types["rcl_interfaces/msg/Log"](stamp=stamp, level=ROS2_LEVELS.get(msg.level, 20),
+                                                      name=msg.name.lstrip("/"), msg=msg.msg, file=msg.file,
+                                                      function=msg.function, line=msg.line)
+    header = store.types["std_msgs/msg/Header"](stamp=stamp, frame_id=msg.header.frame_id)
+    fields = {name: getattr(msg, name) for name in (bag_reader.STRUCTURE_FIELDS if msgtype == smach_msgs.STRUCTURE
+                                                     else bag_reader.STATUS_FIELDS)}
+    if msgtype == smach_msgs.STATUS:
+        fields["local_data"] = numpy.frombuffer(base64.b64decode(msg.local_data), dtype=numpy.uint8)
+    return store.types[msgtype](header=header, **fields)

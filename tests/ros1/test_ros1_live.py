@@ -83,7 +83,7 @@ def test_a_robot_killed_shows_disconnected_and_comes_back_when_started_again(ros
     robots["r2"].proc.wait(10)
     wait_for(lambda: live.machines()["r2"]["connected"] is False, 20, interval=0.1, what="r2 disconnected")
     assert live.machines()["r1"]["connected"] is True
-    robots["r2"] = ros.robot("smach_ros_robot.py", "robot2", "/r2", "/r2/sm_stop", ready=READY)
+    robots["r2"] = ros.robot("smach_ros_loop.py", "robot2", "/r2", "/r2/sm_stop", ready=READY)
     wait_for(lambda: live.machines()["r2"]["connected"] is True, 20, interval=0.1, what="r2 back")
     wait_for(lambda: live.machines()["r2"]["running"], 20, interval=0.1, what="r2's new run")
 

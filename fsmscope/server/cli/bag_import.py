@@ -13,6 +13,7 @@ from fsm.observation.visible import terminal_text
 HELP = "turn a ROS bag of SMACH runs (ROS 1 .bag, ROS 2 sqlite3 or mcap), or fsmscope's MCAP, into an fsmscope log"
 PASSES_ARGUMENTS_ON = False
 EXIT_DAMAGED = 1  # the bag is damaged part way: the events before the damage were written
+EXIT_UNFINISHED = 1  # a machine's last run has no end the bag tells (the log was written; replay: it did not finish)
 EXIT_UNREADABLE = 2  # the bag cannot be read, holds no SMACH introspection or no event that fits the schema,
                      # or the log cannot be written
 SHOWN = 300  # characters of a reason a skipped line shows
@@ -33,8 +34,9 @@ def convert(source: str, log: str, command: str) -> int:
         shown = problem if len(problem) <= SHOWN else problem[:SHOWN] + "…"  # its words may quote a huge path
         print(terminal_text("fsmscope %s: %s: skipped %s" % (command, source, shown)), file=sys.stderr, flush=True)
 
+    untold: list[str] = []
     try:
-        written = write_log(events_of(source, skipped), log, skipped)
+        written = write_log(events_of(source, skipped, untold.append), log, skipped)
     except Damaged as exc:
         print(terminal_text("fsmscope %s: %s; the %d events before it were kept" % (command, exc, exc.written)),
               file=sys.stderr)
@@ -47,16 +49,20 @@ def convert(source: str, log: str, command: str) -> int:
         return EXIT_UNREADABLE
     if command == "import":
         print("fsmscope: wrote %s (%d events)" % (log, written), file=sys.stderr)
-    return 0
+    for said in untold:
+        print(terminal_text("fsmscope %s: %s: %s" % (command, source, said)), file=sys.stderr)
+    return EXIT_UNFINISHED if untold else 0
 
 
-def events_of(source: str, skipped: Callable[[str], None]) -> Iterator[dict]:
-    """The events of an MCAP file fsmscope wrote, else of a ROS bag's SMACH runs."""
+def events_of(source: str, skipped: Callable[[str], None],
+              untold: Callable[[str], None] | None = None) -> Iterator[dict]:
+    """The events of an MCAP file fsmscope wrote, else of a ROS bag's SMACH runs (``untold`` hears of
+    each machine whose last run's end the bag does not tell)."""
     from fsmscope.interop.bag_reader import read_bag
     from fsmscope.interop.mcap_log import is_fsmscope_mcap, read_mcap
     from fsmscope.interop.smach_events import events
 
-    return read_mcap(source, skipped) if is_fsmscope_mcap(source) else events(read_bag(source), skipped)
+    return read_mcap(source, skipped) if is_fsmscope_mcap(source) else events(read_bag(source), skipped, untold)
 
 
 def converts(source: str) -> bool:

@@ -149,12 +149,12 @@ def logged_lines(output: str, first_line: re.Pattern) -> list[tuple[str, str]]:
     return lines
 
 
-READY = r"^ready$"  # what tests/robots/smach_ros_robot.py prints once it publishes
+READY = r"^ready$"  # what tests/robots/smach_ros_loop.py (and smach_ros_robot.py) prints once it publishes
 
 
 @contextlib.contextmanager
 def two_robots(ros: Ros1) -> Iterator[dict[str, Robot]]:
-    """Robots nobody may change (tests/robots/smach_ros_robot.py): r1 (node /robot1, server /r1, stop
+    """Robots nobody may change (tests/robots/smach_ros_loop.py): r1 (node /robot1, server /r1, stop
     topic /r1/sm_stop) and r2 (node /robot2, ...), by their machines' names; the dict may be given
     new robots, which are stopped too."""
     robots = {name: ros.robot("smach_ros_loop.py", node, "/" + name, "/%s/sm_stop" % name, ready=READY)

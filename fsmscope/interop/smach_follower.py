@@ -89,6 +89,17 @@ class Follower:
         out, self._out = self._out, []
         return out if self.refused is None else []
 
+    @property
+    def root(self) -> str | None:
+        """The root container's path, once a message named it."""
+        return self.tree.root
+
+    def event(self, make: Callable[..., dict], path: str, *fields: Any) -> dict:
+        """An event another part adds to this machine's stream (a control asked of the robot): the
+        next seq, at the time of the last message (the robot's clock, so the stream's times stay in order)."""
+        self._event(make, path, *fields)
+        return self._out.pop()
+
     # Describing the tree.
     def _complete(self, t: float) -> bool:
         """Whether every container's structure has come (smach_ros publishes them all at once)."""

@@ -1,4 +1,4 @@
-"""Robots nobody may change, seen live: two real ROS 1 robots (tests/robots/smach_ros_robot.py: the
+"""Robots nobody may change, seen live: two real ROS 1 robots (tests/robots/smach_ros_loop.py: the
 original SMACH with smach_ros's own IntrospectionServer on rospy, a real rosmaster) followed by a real
 ``fsmscope ros1`` process, which has no rospy: it speaks to the master and the robots itself
 (fsmscope/ros1/). Each robot's stop topic is its own (``--stop-topic MACHINE=TOPIC``), so a

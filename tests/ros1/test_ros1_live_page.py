@@ -1,5 +1,5 @@
 """Robots nobody may change, on the dashboard in real Chromium: two real ROS 1 robots
-(tests/robots/smach_ros_robot.py: the original SMACH with smach_ros's own IntrospectionServer) followed
+(tests/robots/smach_ros_loop.py: the original SMACH with smach_ros's own IntrospectionServer) followed
 by a real ``fsmscope ros1`` process. The page shows both machines live, says why its debugger is not
 there, sets a robot's next initial state and preempts its run through its MonitorState, and shows a
 robot killed as disconnected."""

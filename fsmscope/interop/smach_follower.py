@@ -199,12 +199,14 @@ class Follower:
             self._start(path, initial, active, data)
 
     def _concurrence_seen(self, path: str, active: list[str]) -> None:
+        """What a Concurrence's status shows, where no line tells it (with lines, a status may show a
+        child gone before that child's line: children run at once)."""
+        if self.lines:
+            return
         running = self.active[path]
         if any(s not in running for s in active):  # it ran again
             self._terminate(path, None)
             self._start(path, self.tree.children(path), active, self.userdata.get(path, {}))
-            return
-        if self.lines:  # a child's own line tells it returned (a status may show it before: children run at once)
             return
         for child in [s for s in running if s not in active]:
             self._child_returned(path, child, self.returned.get(path, {}).get(child))
@@ -213,9 +215,10 @@ class Follower:
     def _start(self, path: str, initial: list[str], active: list[str], data: dict) -> None:
         above = parent(path)
         if path != self.tree.root and above in self.tree.paths:
-            if above not in self.active:
-                self._start(above, self.tree.initial.get(above) or [label(path)], [label(path)],
-                            self.userdata.get(above, {}))
+            if above not in self.active:  # where it is seen: a Concurrence runs all its children
+                initial = self.tree.initial.get(above) or [label(path)]
+                here = initial if self.tree.kind(above) == CONCURRENCE else [label(path)]
+                self._start(above, initial, here, self.userdata.get(above, {}))
             elif label(path) not in self.active[above] and self.tree.kind(above) != CONCURRENCE:
                 self._move(above, label(path), None)
         if path == self.tree.root:

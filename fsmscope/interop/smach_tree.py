@@ -3,8 +3,9 @@
 A structure message gives a container's children, edges and outcomes (the latest one counts); a
 status gives its initial states and the states it names. Neither names a container's class: a
 status of an idle container tells it (a StateMachine reports ``['None']``, a Concurrence or an
-Iterator no state; a Concurrence lists several initial or active states; an Iterator has the one
-child, whose loop outcomes lead back to it), and so do SMACH's lines ("Concurrence starting",
+Iterator no state; a Concurrence lists all its children as initial states, a StateMachine one of
+them; an Iterator has the one child, whose loop outcomes lead back to it; only a StateMachine has
+an edge from a child to another), and so do SMACH's lines ("Concurrence starting",
 "Iterating"). Until then a container is a StateMachine.
 
 What the edges tell of an outcome: a StateMachine's and an Iterator's edges are every outcome of
@@ -50,8 +51,11 @@ class Tree:
             self.structures[path] = f
             self._leaving.pop(path, None)
             self._changed(path)
-            if any(a == b for a, b in zip(f["outcomes_from"], f["outcomes_to"])) and len(f["children"]) == 1:
+            children = set(f["children"])
+            if any(a == b for a, b in zip(f["outcomes_from"], f["outcomes_to"])) and len(children) == 1:
                 self.kinds[path] = ITERATOR  # its one child's outcome leading back to it: an Iterator's loop
+            elif any(a != b and b in children for a, b in zip(f["outcomes_from"], f["outcomes_to"])):
+                self.kinds[path] = MACHINE  # an edge from a child to another: only a StateMachine's
 
     def status(self, f: dict) -> None:
         path = f["path"]
@@ -63,8 +67,8 @@ class Tree:
         if self.initial.get(path) != initial or (new and path not in self.structures) or path not in self.paths:
             self.initial[path] = initial
             self._changed(path)
-        if f["active_states"] == [NONE]:
-            self.told(path, MACHINE)
+        if f["active_states"] == [NONE] or (len(initial) == 1 and len(self.children(path)) > 1):
+            self.told(path, MACHINE)  # idle; or one initial state of several (a Concurrence's are all)
         elif len(initial) > 1 or len(f["active_states"]) > 1:
             self.told(path, CONCURRENCE)
         elif not f["active_states"] and self.kinds.get(path) != ITERATOR:

@@ -17,7 +17,7 @@ import tempfile
 from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Iterator
+from typing import Any, Callable, Iterator
 
 from rosbags.highlevel import AnyReader
 
@@ -135,7 +135,7 @@ def _read(path: str, p: Path) -> Iterator[Message]:
                     msg = lenient.deserialize_ros1(raw, smach_msgs.STATUS)  # a raw pickle is no UTF-8
                 else:
                     msg = reader.deserialize(raw, connection.msgtype)
-                yield Message(_time(msg.header.stamp, stamp), server, kind, _fields(msg, kind),
+                yield Message(_time(msg.header.stamp, stamp), server, kind, introspection_fields(lambda name: getattr(msg, name), kind),
                               getattr(connection.ext, "callerid", None))
                 count += 1
         except BagError:
@@ -160,11 +160,13 @@ def _time(stamp: object, stamp_ns: int) -> float:
     return stamp.sec + stamp.nanosec * 1e-9 if stamp.sec or stamp.nanosec else stamp_ns * 1e-9
 
 
-def _fields(msg: object, kind: str) -> dict:
+def introspection_fields(value_of: Callable[[str], Any], kind: str) -> dict:
+    """A structure's or a status's fields as the converter takes them (``value_of(name)`` reads one from
+    a bag's message or a live one): the header left out, ``local_data`` as bytes."""
     names = STRUCTURE_FIELDS if kind == "structure" else STATUS_FIELDS
-    out = {name: getattr(msg, name) for name in names}
+    out = {name: value_of(name) for name in names}
     if kind == "status":
-        data = msg.local_data
+        data = value_of("local_data")
         out["local_data"] = data.encode("utf-8", "surrogateescape") if isinstance(data, str) else bytes(data)
     return out
 

@@ -29,7 +29,7 @@ from typing import Any, Callable, Protocol
 
 from fsm.observation import names
 
-from .bag_reader import Message
+from .bag_reader import Message, introspection_fields
 from .smach_follower import Follower
 
 POLL = 1.0  # s between two looks for servers that came or went
@@ -262,8 +262,7 @@ class RosWatcher:
             return
         topic = received.topic
         server = topic[:-len(STATUS_SUFFIX if kind == "status" else STRUCTURE_SUFFIX)]
-        if kind == "status" and isinstance(fields.get("local_data"), str):
-            fields["local_data"] = fields["local_data"].encode("utf-8", "surrogateescape")
+        fields = introspection_fields(fields.__getitem__, kind)
         key = (server, received.publisher)
         machine = self.machines.get(key)
         if machine is None:

@@ -216,9 +216,9 @@ class Follower:
         above = parent(path)
         if path != self.tree.root and above in self.tree.paths:
             if above not in self.active:  # where it is seen: a Concurrence runs all its children
-                initial = self.tree.initial.get(above) or [label(path)]
-                here = initial if self.tree.kind(above) == CONCURRENCE else [label(path)]
-                self._start(above, initial, here, self.userdata.get(above, {}))
+                its_initial = self.tree.initial.get(above) or [label(path)]
+                here = its_initial if self.tree.kind(above) == CONCURRENCE else [label(path)]
+                self._start(above, its_initial, here, self.userdata.get(above, {}))
             elif label(path) not in self.active[above] and self.tree.kind(above) != CONCURRENCE:
                 self._move(above, label(path), None)
         if path == self.tree.root:

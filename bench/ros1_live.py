@@ -98,7 +98,8 @@ class Bench:
         return proc
 
     def robot(self, rate: float) -> subprocess.Popen:
-        return self._start([sys.executable, __file__, "--robot", str(rate)], self.env)
+        return self._start([sys.executable, __file__, "--robot", str(rate)], self.env, stdout=subprocess.DEVNULL,
+                           stderr=subprocess.DEVNULL)  # rospy prints each SMACH line
 
     def last_seq(self) -> int:
         import httpx

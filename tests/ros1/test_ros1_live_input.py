@@ -16,6 +16,7 @@ from fsmscope.ros1 import Node
 from fsmscope.server.testing.polling import wait_for
 
 from fleet_support import started, stop
+from recording_support import cli
 from ros1_support import READY
 
 
@@ -117,3 +118,23 @@ def test_serve_ros1_shows_a_robots_machine_and_follows_it_after_its_master_resta
     finally:
         robot.stop()
         stop(proc)
+
+
+def test_a_headless_recorder_beside_a_robot_writes_a_log_that_replays(ros, tmp_path):
+    robot = ros.robot("smach_ros_loop.py", "robot1", "/r1", "/r1/sm_stop", ready=READY)
+    log = tmp_path / "headless.jsonl"
+    proc, _ = started(["ros1", "--master", ros.master_uri, "--no-serve", "--record", str(log)], r"recording to")
+    try:
+        wait_for(lambda: log.exists() and log.read_text().count('"transition"') >= 3, 30, interval=0.2,
+                 what="three transitions in the log")
+    finally:
+        stop(proc)  # SIGTERM, as a service manager stops it: the log is closed
+        robot.stop()
+    assert proc.returncode == 0
+    printed = cli("replay", str(log))
+    assert "State machine transitioning 'MOVE':'arrived'-->'SCAN'" in printed.stdout, printed.stdout + printed.stderr
+
+
+def test_no_serve_without_record_is_a_usage_error():
+    printed = cli("ros1", "--no-serve")
+    assert printed.returncode == 2 and "--no-serve needs --record" in printed.stderr

@@ -10,6 +10,7 @@ ROS way) when it first shows, and is shown disconnected while its robot publishe
 from __future__ import annotations
 
 import argparse
+import signal
 import sys
 from typing import TYPE_CHECKING, Any, Callable
 
@@ -125,6 +126,10 @@ def join(graph: str, make_node: Callable[[], Any], flavour: Flavour) -> tuple[st
         raise CannotServe("cannot join %s: %s" % (graph, exc)) from None
 
 
+def _interrupted(signum: int, frame: Any) -> None:
+    raise KeyboardInterrupt
+
+
 def serve_live(args: argparse.Namespace, joined: Callable[[], tuple[str, Any, Flavour]]) -> int:
     """``fsmscope ros1/ros2``: the graph's machines served (unless --no-serve) and recorded (--record)
     until Ctrl-C."""
@@ -141,6 +146,7 @@ def serve_live(args: argparse.Namespace, joined: Callable[[], tuple[str, Any, Fl
     if args.record is not None and os.path.exists(args.record):
         raise CannotServe("%s exists already: the recording is a new file" % args.record)
     graph, node, flavour = joined()
+    signal.signal(signal.SIGTERM, _interrupted)  # a headless recorder stopped by its service manager closes its log
     recorder = Recorder(args.record) if args.record is not None else None
     srv = watcher = None
     try:

@@ -11,6 +11,7 @@ ROBOT
                   (up to MAX_TRIES); MOVE counts the rounds in the userdata
   PATROL 'stopped' (MONITOR_STOP 'invalid') -> DOCK -> 'stopped'
 """
+import os
 import sys
 import threading
 
@@ -21,24 +22,10 @@ import smach_ros
 from fsmscope import IntrospectionServer
 from std_msgs.msg import Empty
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # run with runpy: its folder is not on the path
+from rospy_states import Timed  # noqa: E402
+
 MAX_TRIES = 3
-
-
-class Timed(smach.State):
-    """Works ``seconds`` of ROS time, then returns ``done(ud)``; 'preempted' as soon as it is asked to."""
-
-    def __init__(self, seconds, outcomes, **keys):
-        smach.State.__init__(self, outcomes + ["preempted"], **keys)
-        self.seconds = seconds
-
-    def execute(self, ud):
-        end = rospy.get_time() + self.seconds
-        while rospy.get_time() < end:
-            if self.preempt_requested():
-                self.service_preempt()
-                return "preempted"
-            rospy.sleep(0.02)
-        return self.done(ud)
 
 
 class Move(Timed):

@@ -11,6 +11,7 @@ SERVER, runs it again one second after each run ends, prints ``ready`` once it p
              SCAN ends WORK 'done' after ROUNDS rounds (default 1000: until stopped)
   RUN 'stopped' -> DOCK -> 'stopped'; RUN 'done' -> 'done'
 """
+import os
 import sys
 import threading
 
@@ -19,29 +20,16 @@ import smach
 import smach_ros
 from std_msgs.msg import Empty
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # run with runpy: its folder is not on the path
+from rospy_states import Timed  # noqa: E402
+
 NODE, SERVER, STOP_TOPIC = sys.argv[1:4]
 ROUNDS = int(sys.argv[4]) if len(sys.argv) > 4 else 1000
 
 
-class Timed(smach.State):
-    """Works 0.3 s of ROS time, then returns ``done(ud)``; 'preempted' as soon as it is asked to."""
-
-    def __init__(self, outcomes, **keys):
-        smach.State.__init__(self, outcomes + ["preempted"], **keys)
-
-    def execute(self, ud):
-        end = rospy.get_time() + 0.3
-        while rospy.get_time() < end:
-            if self.preempt_requested():
-                self.service_preempt()
-                return "preempted"
-            rospy.sleep(0.02)
-        return self.done(ud)
-
-
 class Move(Timed):
     def __init__(self):
-        Timed.__init__(self, ["arrived"], input_keys=["rounds"], output_keys=["rounds"])
+        Timed.__init__(self, 0.3, ["arrived"], input_keys=["rounds"], output_keys=["rounds"])
 
     def done(self, ud):
         ud.rounds = ud.rounds + 1
@@ -50,7 +38,7 @@ class Move(Timed):
 
 class Scan(Timed):
     def __init__(self):
-        Timed.__init__(self, ["scanned", "finished"], input_keys=["rounds"])
+        Timed.__init__(self, 0.3, ["scanned", "finished"], input_keys=["rounds"])
 
     def done(self, ud):
         return "finished" if ud.rounds >= ROUNDS else "scanned"
@@ -58,7 +46,7 @@ class Scan(Timed):
 
 class Dock(Timed):
     def __init__(self):
-        Timed.__init__(self, ["docked"])
+        Timed.__init__(self, 0.3, ["docked"])
 
     def done(self, ud):
         return "docked"

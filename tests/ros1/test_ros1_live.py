@@ -9,25 +9,12 @@ from __future__ import annotations
 import re
 import signal
 
-import pytest
 from fsm.logfiles.log_reader import read_events
 from fsmscope.server.testing.polling import wait_for
 
 from fleet_support import stop
 from recording_support import cli
-from ros1_support import READY, Robot, live_viewer, rospy_lines, two_robots
-
-@pytest.fixture(scope="module")
-def robots(ros):
-    with two_robots(ros) as started_robots:
-        yield started_robots
-
-
-@pytest.fixture(scope="module")
-def live(ros, robots):
-    with live_viewer(ros) as viewer:
-        yield viewer
-
+from ros1_support import READY, Robot, rospy_lines
 
 def _moved(events: list[dict]) -> list[dict]:
     return [e for e in events if e["kind"] == "transition" and e["path"] == "/SM_ROOT/RUN/WORK"]

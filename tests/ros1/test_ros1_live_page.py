@@ -13,21 +13,8 @@ import pytest
 from fsmscope.server.testing.polling import wait_for
 
 from browser_support import page_at
-from ros1_support import live_viewer, two_robots
 
 pytestmark = pytest.mark.browser  # real Chromium, as the browser layer's tests
-
-
-@pytest.fixture(scope="module")
-def robots(ros):
-    with two_robots(ros) as started_robots:
-        yield started_robots
-
-
-@pytest.fixture(scope="module")
-def live(ros, robots):
-    with live_viewer(ros) as viewer:
-        yield viewer
 
 
 def active_in_work(page) -> str | None:

@@ -18,7 +18,7 @@ from fsm.control.controls import Refused
 
 from ..remote_control import RemoteHandle, not_connected, remote_controls, taken
 from .cannot_serve import CannotServe
-from .loop_inbox import LoopInbox
+from .loop_inbox import LoopInbox, ingest_in_order
 from .serving import SWITCH_INTERVAL
 from .zenoh_options import reach, zenoh_tokens
 
@@ -88,12 +88,7 @@ def start_fleet(args: argparse.Namespace, hub: Hub) -> FleetWatcher:
 
     def ingest(events: list[dict]) -> None:
         """One machine's events, in order."""
-        for event in events:
-            problem = hub.ingest(event, "ingest")
-            if problem:
-                print("fsmscope serve: refused an event of %s from Zenoh: %s" % (event.get("machine"), problem),
-                      file=sys.stderr, flush=True)
-        entry = hub.get(events[0]["machine"])
+        entry = ingest_in_order(hub, events, "Zenoh")
         if entry is None:
             return
         entry.origin.connected = alive.get(entry.name, True)

@@ -1,12 +1,17 @@
 """What another thread hands to a server's event loop: the fleet's watcher (fleet_bridge.py) and a ROS
-graph's (ros_live.py) deliver events from threads of their own, the hub takes them on its loop."""
+graph's (ros_live.py) deliver events from threads of their own, the hub takes them on its loop
+(``ingest_in_order``)."""
 
 from __future__ import annotations
 
 import asyncio
 import collections
 import threading
-from typing import Callable
+import sys
+from typing import TYPE_CHECKING, Callable
+
+if TYPE_CHECKING:
+    from ..hub import Hub, MachineEntry
 
 
 class LoopInbox:
@@ -40,3 +45,14 @@ class LoopInbox:
         for _ in range(len(calls)):  # those posted meanwhile come with a wake of their own
             call, args = calls.popleft()
             call(*args)
+
+
+def ingest_in_order(hub: Hub, events: list[dict], where: str) -> MachineEntry | None:
+    """One machine's ``events``, in order, through the hub's ingest door (each checked against the
+    schema, one refused said on stderr as coming from ``where``); the machine's entry."""
+    for event in events:
+        problem = hub.ingest(event, "ingest")
+        if problem:
+            print("fsmscope: refused an event of %s from %s: %s" % (event.get("machine"), where, problem),
+                  file=sys.stderr, flush=True)
+    return hub.get(events[0]["machine"])

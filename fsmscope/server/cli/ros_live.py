@@ -15,7 +15,7 @@ import sys
 from typing import TYPE_CHECKING, Any, Callable
 
 from .cannot_serve import CannotServe
-from .loop_inbox import LoopInbox
+from .loop_inbox import LoopInbox, ingest_in_order
 from .serving import SWITCH_INTERVAL
 
 if TYPE_CHECKING:
@@ -61,13 +61,8 @@ def follow(node: Any, flavour: Flavour, hub: Hub | None, recorder: Recorder | No
         sys.setswitchinterval(SWITCH_INTERVAL)
 
     def ingest(events: list[dict]) -> None:
-        for event in events:
-            problem = hub.ingest(event, "ingest")
-            if problem:
-                print("fsmscope: refused an event of %s from the ROS graph: %s" % (event.get("machine"), problem),
-                      file=sys.stderr, flush=True)
+        entry = ingest_in_order(hub, events, "the ROS graph")
         name = events[0]["machine"]
-        entry = hub.get(name)
         machine = watcher.machine(name)
         if entry is None or machine is None:
             return

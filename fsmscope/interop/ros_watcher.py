@@ -113,6 +113,7 @@ class RosWatcher:
         self._subscriptions: dict[str, Any] = {}  # topic -> its subscription
         self._publications: dict[str, Any] = {}  # topic -> its publication
         self._told: set[str] = set()  # what was said once
+        self._problems: dict[str, list[str]] = {}  # topic -> its subscription's problems, as last said
         self._waiting: list[tuple[float, int, float, str, Any]] = []  # (stamp, order, arrived, kind, received)
         self._order = itertools.count()
         self._lock = threading.Lock()  # the followers, the machines and the waiting messages
@@ -134,13 +135,16 @@ class RosWatcher:
 
     def machine(self, name: str) -> Machine | None:
         with self._lock:
-            return next((m for m in self.machines.values() if m.name == name), None)
+            return self._named(name)
+
+    def _named(self, name: str) -> Machine | None:
+        return next((m for m in self.machines.values() if m.name == name), None)
 
     def emit(self, name: str, make: Callable[..., dict], path: str | None, *fields: Any) -> int:
         """An event this process adds to the machine's stream (a control and its result): made by its
         follower, after every event delivered so far; its seq."""
         with self._lock:
-            machine = next((m for m in self.machines.values() if m.name == name), None)
+            machine = self._named(name)
             if machine is None:
                 raise KeyError(name)
             event = machine.follower.event(make, path, *fields)
@@ -171,7 +175,8 @@ class RosWatcher:
 
     def _advertise_controls(self, machine: Machine) -> None:
         """The topics of the machine's controls, advertised as soon as it is found (``advertise``)."""
-        for topic, type_name in ((machine.stop_topic, self.flavour.empty), (machine.server + INIT_SUFFIX, self.flavour.init)):
+        flavour = self.flavour
+        for topic, type_name in ((machine.stop_topic, flavour.empty), (machine.server + INIT_SUFFIX, flavour.init)):
             try:
                 self.advertise(topic, type_name)
             except Exception as exc:  # the control says so again when it is used
@@ -190,7 +195,17 @@ class RosWatcher:
                 for topic, type_name in sorted(topics.items()):
                     if topic.endswith(STATUS_SUFFIX) or topic.endswith(STRUCTURE_SUFFIX):
                         self._found(topic, type_name)
+            for topic, subscription in list(self._subscriptions.items()):
+                self._say_problems(topic, subscription.problems)
             self._stopped.wait(self._poll)
+
+    def _say_problems(self, topic: str, problems: list[str]) -> None:
+        """What a subscription refused or could not decode since it was last asked (its last few)."""
+        before = self._problems.get(topic, [])
+        for problem in problems:
+            if problem not in before:
+                self._said("%s: %s" % (topic, problem))
+        self._problems[topic] = problems
 
     def _found(self, topic: str, type_name: str) -> None:
         status = topic.endswith(STATUS_SUFFIX)

@@ -25,8 +25,7 @@ from . import safe_pickle, smach_lines
 from .bag_reader import Message
 from .smach_tree import CONCURRENCE, ITERATOR, MACHINE, NONE, UNKNOWN, Tree, label, parent
 
-WAIT = 2.5  # seconds of messages held at most until every container's structure came (smach_ros: every 2 s)
-TOGETHER = 0.5  # seconds after the first structure by which every container's has come (published together)
+WAIT = 2.5  # seconds of messages held until every container's structure came (each, every 2 to 2.1 s)
 HELD = 100_000  # messages held at most while waiting
 NOT_STEPS = ("HEARTBEAT", "Initial state", "REMOTE_INIT", "")  # a status's info that is not a transition's
 UNTOLD = {"$repr": "<not published yet>"}  # a key a start line names, whose value no status gave yet
@@ -40,7 +39,6 @@ class Follower:
         self.tree = Tree()
         self.described = -1  # the tree's version last described
         self.held: list[Message] = []  # before the first description
-        self.first_structure: float | None = None
         self.refused: str | None = None  # why the schema refuses the structure: then no events
         self.active: dict[str, list[str]] = {}  # running containers -> their active states
         self.userdata: dict[str, dict] = {}  # container -> its userdata, last seen, encoded
@@ -65,13 +63,12 @@ class Follower:
         self.t = max(self.t, m.t)
         if m.kind == "structure":
             self.tree.structure(m.fields)
-            self.first_structure = m.t if self.first_structure is None else self.first_structure
         elif m.kind == "status":
             self.tree.status(m.fields)
         if self.described < 0:
             if len(self.held) < HELD:
                 self.held.append(m)
-            if self._complete(m.t) or (self.tree.root is not None and m.t - self.held[0].t >= WAIT):
+            if self.tree.root is not None and m.t - self.held[0].t >= WAIT:
                 self._release()
         else:
             self._apply(m)
@@ -101,11 +98,6 @@ class Follower:
         return self._out.pop()
 
     # Describing the tree.
-    def _complete(self, t: float) -> bool:
-        """Whether every container's structure has come (smach_ros publishes them all at once)."""
-        return (self.first_structure is not None and t - self.first_structure >= TOGETHER
-                and all(p in self.tree.structures for p in self.tree.paths))
-
     def _release(self) -> None:
         held, self.held = self.held, []
         self.t = held[0].t if held else self.t

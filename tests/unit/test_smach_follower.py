@@ -70,8 +70,8 @@ def test_statuses_before_the_structure_are_told_from_the_structure_once_it_comes
 def test_a_structure_that_changes_is_described_again():
     f = Follower("robot", "robot")
     first = [ev for m in (structure(0, ROOT, ["INIT", "WORK"], PATROL[:1], ["done"]),
-                          status(0.6, ROOT, ["INIT"], ["None"])) for ev in f.feed(m)]
-    again = f.feed(structure(2, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]))
+                          status(2.6, ROOT, ["INIT"], ["None"])) for ev in f.feed(m)]
+    again = f.feed(structure(4, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]))
     assert [ev["kind"] for ev in first] == ["structure"]
     assert [c["label"] for c in again[0]["root"]["children"]] == ["INIT", "WORK", "RECOVER"]
 
@@ -111,14 +111,14 @@ def test_a_line_of_another_node_says_nothing_of_this_servers_machine():
 
 def test_whether_the_last_run_finished_is_known_only_from_its_end():
     f = Follower("robot", "robot")
-    for m in (structure(0, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]), status(0.6, ROOT, ["INIT"], ["None"])):
+    for m in (structure(0, ROOT, ["INIT", "WORK", "RECOVER"], PATROL, ["done"]), status(2.6, ROOT, ["INIT"], ["None"])):
         f.feed(m)
     assert f.finished is None
-    f.feed(line(1, "State machine starting in initial state 'INIT' with userdata: \n\t[]"))
+    f.feed(line(3, "State machine starting in initial state 'INIT' with userdata: \n\t[]"))
     assert f.finished is False
-    f.feed(line(2, "State machine transitioning 'INIT':'go'-->'WORK'"))
-    f.feed(line(3, "State machine transitioning 'WORK':'tired'-->'RECOVER'"))
-    ended = f.feed(line(4, "State machine terminating 'RECOVER':'rested':'done'"))
+    f.feed(line(4, "State machine transitioning 'INIT':'go'-->'WORK'"))
+    f.feed(line(5, "State machine transitioning 'WORK':'tired'-->'RECOVER'"))
+    ended = f.feed(line(6, "State machine terminating 'RECOVER':'rested':'done'"))
     assert (ended[-1]["kind"], ended[-1]["outcome"]) == ("terminate", "done") and f.finished is True
 
 

@@ -6,6 +6,7 @@ import xml.etree.ElementTree as ET
 
 import fsm
 import httpx
+from fsm.control.handle import CANNOT_HOLD
 from fsm.ros.bus import default_bus
 
 from fsmscope.server.testing.polling import wait_for
@@ -55,8 +56,9 @@ def test_lists_machines(live_server):
     live_server.hub.add_local(two_state_machine(), name="two")
     [info] = client(live_server).get("/api/machines").json()
     assert info == {"name": "two", "running": False, "outcome": None, "last_seq": 0, "root_path": "/SM_ROOT",
-                    "can_start": True, "can_hold": False, "held": False, "source": "local", "controllable": True,
-                    "connected": None, "rejected": 0, "replay": None, "script": None}
+                    "can_start": True, "can_hold": False, "held": False, "cannot": {"hold": CANNOT_HOLD},
+                    "source": "local", "controllable": True, "connected": None, "rejected": 0, "replay": None,
+                    "script": None}
 
 
 def test_structure_and_status_after_a_run(live_server):

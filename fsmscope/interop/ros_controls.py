@@ -50,7 +50,8 @@ def plain(value: Any, where: str = "userdata") -> Any:
             if type(key) is not str:
                 raise ValueError("%s has a key %r that is not a string" % (where, key))
         return {k: plain(v, "%s.%s" % (where, k)) for k, v in value.items()}
-    raise ValueError("%s is a %s: only dict, list, str, numbers, bools and None are sent" % (where, type(value).__name__))
+    raise ValueError("%s is a %s: only dict, list, str, numbers, bools and None are sent"
+                     % (where, type(value).__name__))
 
 
 def _in_process_only(action: str) -> Any:
@@ -98,7 +99,8 @@ class RosControls:
         path = path or machine.follower.root
         params = {"path": path, "states": states, "userdata": userdata or {}}
         if not states or any(type(s) is not str for s in states):
-            return self._refuse("initial-state", client, 422, "the initial states must be a non-empty list of names", params)
+            return self._refuse("initial-state", client, 422, "the initial states must be a non-empty list of names",
+                                params)
         try:
             data = pickle.dumps(plain(userdata or {}), 2)
         except ValueError as exc:

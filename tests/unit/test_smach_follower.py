@@ -150,3 +150,16 @@ def test_a_machine_that_starts_again_before_its_end_was_told_ends_untold_first()
                  line(5, "State machine starting in initial state 'INIT' with userdata: \n\t[]")]) == [
         ("start", ROOT, None, None, None), ("transition", ROOT, "INIT", "go", "WORK"),
         ("terminate", ROOT, None, "?", None), ("start", ROOT, None, None, None)]
+
+
+def test_a_heartbeat_published_between_smachs_change_of_state_and_its_line_does_not_hide_the_line():
+    # SMACH sets the state, then logs the line that says it (state_machine.py): smach_ros's heartbeat
+    # thread may publish between the two, stamped a moment before the line.
+    edges = [("ok", "A", "B"), ("ok", "B", "done"), ("fail", "B", "done")]
+    bag = [structure(0, ROOT, ["A", "B"], edges, ["done"]),
+           line(0.1, "State machine starting in initial state 'A' with userdata: \n\t[]"),
+           status(0.1, ROOT, ["A"], ["A"], info="Initial state"),
+           line(0.4, "State machine transitioning 'A':'ok'-->'B'"), status(0.4001, ROOT, ["A"], ["B"], info=STEP),
+           status(0.7, ROOT, ["A"], ["None"]), line(0.7002, "State machine terminating 'B':'fail':'done'")]
+    ended = [ev for ev in smach_events.events(bag) if ev["kind"] == "terminate"]
+    assert [(ev["outcome"], ev.get("state_outcome")) for ev in ended] == [("done", "fail")]

@@ -30,7 +30,7 @@ from typing import Any, Callable, Protocol
 from fsm.observation import names
 
 from .bag_reader import Message, introspection_fields
-from .smach_follower import Follower, feed_time
+from .smach_follower import Follower
 
 POLL = 1.0  # s between two looks for servers that came or went
 WINDOW = 0.02  # s a message waits for those stamped before it on the other topics (within the page's 50 ms)
@@ -114,7 +114,7 @@ class RosWatcher:
         self._publications: dict[str, Any] = {}  # topic -> its publication
         self._told: set[str] = set()  # what was said once
         self._problems: dict[str, list[str]] = {}  # topic -> its subscription's problems, as last said
-        self._waiting: list[tuple[float, int, float, str, Any]] = []  # (feed time, order, arrived, kind, received)
+        self._waiting: list[tuple[float, int, float, str, Any]] = []  # (stamp, order, arrived, kind, received)
         self._order = itertools.count()
         self._lock = threading.Lock()  # the followers, the machines and the waiting messages
         self._advertising = threading.Lock()  # the publications (a master's answer is not waited for under _lock)
@@ -230,9 +230,8 @@ class RosWatcher:
 
     # The readers' threads: what arrived waits for its window.
     def _arrived(self, kind: str, received: Any) -> None:
-        at = feed_time(Message(_stamp(received), "", kind, received.fields))  # a heartbeat a little later
         with self._wake:
-            heapq.heappush(self._waiting, (at, next(self._order), time.monotonic(), kind, received))
+            heapq.heappush(self._waiting, (_stamp(received), next(self._order), time.monotonic(), kind, received))
             self._wake.notify()
 
     def _publishers(self, server: str, publishers: list[str]) -> None:

@@ -18,7 +18,7 @@ from typing import Callable, Iterable, Iterator
 from fsm.observation import names
 
 from .bag_reader import Message
-from .smach_follower import WAIT, Follower, feed_time
+from .smach_follower import WAIT, Follower
 from .smach_tree import UNKNOWN
 
 __all__ = ["Follower", "UNKNOWN", "events", "in_time_order"]
@@ -28,11 +28,10 @@ ORPHAN_LINES = 1000  # lines kept of a node whose server no message named yet
 
 
 def in_time_order(messages: Iterable[Message], window: float = WINDOW) -> Iterator[Message]:
-    """``messages`` in the order a follower takes them (``feed_time``: their stamps, a heartbeat a little
-    later), each let out once one ``window`` seconds later has come."""
+    """``messages`` in the order of their stamps, each let out once one ``window`` seconds later has come."""
     heap: list[tuple[float, int, Message]] = []
     for n, m in enumerate(messages):
-        heapq.heappush(heap, (feed_time(m), n, m))
+        heapq.heappush(heap, (m.t, n, m))
         while heap[0][0] < m.t - window:
             yield heapq.heappop(heap)[2]
     while heap:

@@ -32,16 +32,7 @@ NOT_STEPS = (HEARTBEAT, "Initial state", "REMOTE_INIT", "")  # a status's info t
 UNTOLD = {"$repr": "<not published yet>"}  # a key a start line names, whose value no status gave yet
 
 
-HEARTBEAT_LATE = 0.05  # s after its stamp a heartbeat is given to a follower (``feed_time``)
-
-
-def feed_time(m: Message) -> float:
-    """Where ``m`` goes among the messages given to a follower: its stamp, a heartbeat's a little later.
-    SMACH sets a machine's new state, then logs the line that says how it got there
-    (state_machine.py); smach_ros's heartbeat thread may publish between the two, stamped a moment
-    before the line. Taken a little later, it comes after the line, which tells the outcome; it
-    shows nothing a status of the machine's own thread does not show sooner."""
-    return m.t + HEARTBEAT_LATE if m.kind == "status" and m.fields.get("info") == HEARTBEAT else m.t
+IDLE_WAIT = 0.05  # s of stream a heartbeat that shows a running machine idle waits for its terminating line
 
 
 class Follower:
@@ -61,6 +52,7 @@ class Follower:
         self.returned: dict[str, dict[str, str]] = {}  # a running Concurrence's children's told outcomes
         self.closing: dict[str, dict[str, str]] = {}  # Concurrences whose end a line told, outcome untold yet
         self.lines = False  # whether SMACH's lines tell this machine
+        self.idle_seen: dict[str, float] = {}  # running machines a heartbeat showed idle -> when (``_idle``)
         self.fresh: set[str] = set()  # containers seen idle, or just entered: a run of theirs starts at the start
         self.seq = self.runs = 0
         self.run: str | None = None
@@ -93,6 +85,7 @@ class Follower:
         without their outcome); what still runs stays running."""
         if self.refused is None and self.described < 0 and self.tree.root is not None:
             self._release()
+        self._end_idle(float("inf"))
         for path in sorted(self.closing, key=len, reverse=True):
             if path in self.closing:
                 self._terminate(path, None)
@@ -128,6 +121,7 @@ class Follower:
             self.refused = problem
 
     def _apply(self, m: Message) -> None:
+        self._end_idle(m.t)
         if self.tree.version != self.described:
             self._describe()
         if m.kind == "status":
@@ -165,7 +159,10 @@ class Follower:
         if kind == CONCURRENCE:
             self._concurrence_seen(path, active)
         elif not active:
-            self._terminate(path, None)
+            if self.lines and f["info"] == HEARTBEAT:
+                self.idle_seen.setdefault(path, self.t)
+            else:
+                self._terminate(path, None)
         elif stepped and self.pending.get(path):
             self.pending[path] -= 1
             if active != self.active[path]:
@@ -174,6 +171,18 @@ class Follower:
             source = self.active[path][0] if self.active[path] else ""
             self._move(path, active[0], None)
             self.inferred[path] = (source, active[0])
+
+    def _end_idle(self, t: float) -> None:
+        """End the machines a heartbeat showed idle ``IDLE_WAIT`` ago whose terminating line did not come.
+        SMACH sets a machine's state to none, then logs the line that says how it ended
+        (state_machine.py); smach_ros's heartbeat thread may publish between the two, stamped a moment
+        before the line. Ended at once, the line would find no running machine and its outcome be lost."""
+        for path, seen in list(self.idle_seen.items()):
+            if path not in self.active:
+                del self.idle_seen[path]
+            elif t >= seen + IDLE_WAIT:
+                del self.idle_seen[path]
+                self._terminate(path, None)
 
     def _userdata(self, path: str, data: dict) -> None:
         old = self.userdata.get(path)

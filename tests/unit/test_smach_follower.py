@@ -152,14 +152,38 @@ def test_a_machine_that_starts_again_before_its_end_was_told_ends_untold_first()
         ("terminate", ROOT, None, "?", None), ("start", ROOT, None, None, None)]
 
 
+EDGES_TO_DONE = [("ok", "A", "B"), ("ok", "B", "done"), ("fail", "B", "done")]
+
+
+def run_of_a_then_b(*end: Message) -> list[Message]:
+    """A -> B of a machine whose B has two edges to 'done', with SMACH's lines, then ``end``."""
+    return [structure(0, ROOT, ["A", "B"], EDGES_TO_DONE, ["done"]),
+            line(0.1, "State machine starting in initial state 'A' with userdata: \n\t[]"),
+            status(0.1, ROOT, ["A"], ["A"], info="Initial state"),
+            line(0.4, "State machine transitioning 'A':'ok'-->'B'"), status(0.4001, ROOT, ["A"], ["B"], info=STEP),
+            *end]
+
+
+def ends(messages: list[Message]) -> list[tuple]:
+    return [(ev["kind"], ev.get("outcome"), ev.get("state_outcome")) for ev in smach_events.events(messages)
+            if ev["kind"] in ("start", "terminate")]
+
+
 def test_a_heartbeat_published_between_smachs_change_of_state_and_its_line_does_not_hide_the_line():
-    # SMACH sets the state, then logs the line that says it (state_machine.py): smach_ros's heartbeat
-    # thread may publish between the two, stamped a moment before the line.
-    edges = [("ok", "A", "B"), ("ok", "B", "done"), ("fail", "B", "done")]
-    bag = [structure(0, ROOT, ["A", "B"], edges, ["done"]),
-           line(0.1, "State machine starting in initial state 'A' with userdata: \n\t[]"),
-           status(0.1, ROOT, ["A"], ["A"], info="Initial state"),
-           line(0.4, "State machine transitioning 'A':'ok'-->'B'"), status(0.4001, ROOT, ["A"], ["B"], info=STEP),
-           status(0.7, ROOT, ["A"], ["None"]), line(0.7002, "State machine terminating 'B':'fail':'done'")]
-    ended = [ev for ev in smach_events.events(bag) if ev["kind"] == "terminate"]
-    assert [(ev["outcome"], ev.get("state_outcome")) for ev in ended] == [("done", "fail")]
+    # SMACH sets the state to none, then logs the line that says how the machine ended (state_machine.py):
+    # smach_ros's heartbeat thread may publish between the two, stamped a moment before the line.
+    told = ends(run_of_a_then_b(status(0.7, ROOT, ["A"], ["None"]),
+                                line(0.7002, "State machine terminating 'B':'fail':'done'")))
+    assert told[-1] == ("terminate", "done", "fail")
+
+
+def test_a_heartbeat_stamped_just_before_the_terminating_line_does_not_run_the_machine_again():
+    told = ends(run_of_a_then_b(status(0.69, ROOT, ["A"], ["B"]),
+                                line(0.7, "State machine terminating 'B':'fail':'done'"),
+                                status(2.7, ROOT, ["A"], ["None"])))
+    assert [kind for kind, _, _ in told] == ["start", "terminate"] and told[-1] == ("terminate", "done", "fail")
+
+
+def test_without_its_line_a_machine_a_heartbeat_shows_idle_ends_with_what_its_edges_tell():
+    told = ends(run_of_a_then_b(status(0.7, ROOT, ["A"], ["None"]), status(2.7, ROOT, ["A"], ["None"])))
+    assert told[-1] == ("terminate", "done", "?")

@@ -7,6 +7,7 @@ import argparse
 import os
 from typing import Any
 
+from .cannot_serve import CannotServe
 from .ros_live import add_live_arguments, add_recording_arguments, join, serve_live, unused_live
 from .serving import add_server_arguments, foxglove_unused
 
@@ -38,8 +39,13 @@ def unused(args: argparse.Namespace, given: set[str]) -> str | None:
 def graph(domain: int, interface: str | None) -> tuple[str, Any, Any]:
     """The domain's graph in words, a node that joined it, ROS 2's flavour; CannotServe saying why not."""
     from fsmscope.interop.ros_watcher import ROS2
-    from fsmscope.ros2 import Node
 
+    try:
+        from fsmscope.ros2 import Node
+    except ImportError as exc:
+        raise CannotServe("ROS 2 needs the cyclonedds package, not installed here (%s): pip installs it with "
+                          "fsmscope where it has a wheel (x86_64, Windows, macOS on arm64); elsewhere install Cyclone "
+                          "DDS, then `pip install cyclonedds` (docs/ros2.md)" % exc) from None
     return join("the ROS 2 domain %d" % domain, lambda: Node(domain, interface=interface), ROS2)
 
 

@@ -7,7 +7,9 @@ from fsmscope.server.cli import main
 
 
 def test_fsmscope_ros2_without_cyclonedds_says_what_to_install(monkeypatch, capsys):
-    monkeypatch.setitem(sys.modules, "cyclonedds", None)  # `import cyclonedds` raises ImportError
+    # `import cyclonedds` and its modules raise ImportError, also where an earlier test imported them.
+    for name in ["cyclonedds", *[n for n in sys.modules if n.startswith("cyclonedds.")]]:
+        monkeypatch.setitem(sys.modules, name, None)
     for name in [n for n in sys.modules if n == "fsmscope.ros2" or n.startswith("fsmscope.ros2.")]:
         monkeypatch.delitem(sys.modules, name)
     assert main(["ros2", "--port", "0"]) == 1

@@ -90,15 +90,20 @@ def announce_viewer(args: argparse.Namespace, srv: ServerThread) -> None:
         print("fsmscope: viewer (watch only) at %s" % srv.viewer_url, file=sys.stderr, flush=True)
 
 
+INTERRUPT_CHECK = 0.2  # s between two looks for a Ctrl-C that reached another thread (wait_for_interrupt)
 SWITCH_INTERVAL = 0.0005  # s a thread may hold the GIL while another waits for it (Python's default: 5 ms)
 
 
 def wait_for_interrupt(announcement: str) -> None:
     """Say ``announcement`` (the line that says Ctrl-C stops) on stderr, then wait for Ctrl-C. The
     line is written inside the wait's guard: a Ctrl-C sent as soon as it is read stops the command as
-    cleanly as one sent later."""
+    cleanly as one sent later. The wait wakes every ``INTERRUPT_CHECK`` seconds: the kernel may hand the
+    signal to another of the process's threads (the server's), and a wait with no end in the main
+    thread would then never return to run Python's handler."""
+    never = threading.Event()
     try:
         print(announcement, file=sys.stderr, flush=True)
-        threading.Event().wait()
+        while not never.wait(INTERRUPT_CHECK):
+            pass
     except KeyboardInterrupt:
         pass

@@ -33,7 +33,7 @@ def add_live_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def stop_topics(given: list[str]) -> Callable[[str], str]:
-    """Each machine's stop topic, from ``--stop-topic`` values; ValueError for one that is not a ROS name."""
+    """Each machine's stop topic, from ``--stop-topic`` values; CannotServe for one that is not a ROS name."""
     from fsmscope.interop.ros_watcher import STOP_TOPIC
 
     by_machine: dict[str, str] = {}
@@ -41,7 +41,7 @@ def stop_topics(given: list[str]) -> Callable[[str], str]:
     for value in given:
         machine, _, topic = value.rpartition("=")
         if not topic.startswith("/") or " " in topic:
-            raise ValueError("--stop-topic %s: a topic is a ROS name that starts with /" % value)
+            raise CannotServe("--stop-topic %s: a topic is a ROS name that starts with /" % value)
         if machine:
             by_machine[machine] = topic
         else:
@@ -91,10 +91,7 @@ def follow(node: Any, flavour: Flavour, hub: Hub | None, recorder: Recorder | No
             inbox.post(seen, name, up)
             inbox.wake()
 
-    try:
-        watcher = RosWatcher(node, flavour, deliver, seen_from_watcher, stop_topic=stop_topic)
-    except ValueError as exc:
-        raise CannotServe(str(exc)) from None
+    watcher = RosWatcher(node, flavour, deliver, seen_from_watcher, stop_topic=stop_topic)
     return watcher
 
 
@@ -134,10 +131,7 @@ def serve_live(args: argparse.Namespace, joined: Callable[[], tuple[str, Any, Fl
 
     from .serving import announce_viewer, start_server, wait_for_interrupt
 
-    try:
-        topics = stop_topics(args.stop_topic)
-    except ValueError as exc:
-        raise CannotServe(str(exc)) from None
+    topics = stop_topics(args.stop_topic)
     if args.record is not None and os.path.exists(args.record):
         raise CannotServe("%s exists already: the recording is a new file" % args.record)
     graph, node, flavour = joined()

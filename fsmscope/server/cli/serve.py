@@ -45,6 +45,7 @@ def unused(args: argparse.Namespace, given: set[str]) -> str | None:
 
 
 def main(args: argparse.Namespace) -> int:
+    topics = stop_topics(args.stop_topic)
     srv = start_server(args)
     try:
         if args.zenoh is not None:
@@ -52,7 +53,7 @@ def main(args: argparse.Namespace) -> int:
 
             start_fleet(args, srv.hub)
         for graph, node, flavour in ros_graphs(args):
-            follow(node, flavour, srv.hub, None, stop_topics(args.stop_topic))
+            follow(node, flavour, srv.hub, None, topics)
             print("fsmscope: following the SMACH machines of %s" % graph, file=sys.stderr, flush=True)
     except CannotServe:
         srv.stop()

@@ -49,9 +49,13 @@ class UserData:
         dirty = self._dirty
         if not dirty:
             return None
-        object.__setattr__(self, "_dirty", set())
         data = self._data
-        return {k: data[k] for k in dirty if k in data}
+        if len(dirty) == 1:  # a step's usual write: no comprehension (a function and a frame in 3.11)
+            key = dirty.pop()
+            return {key: data[key]} if key in data else {}
+        written = {k: data[k] for k in dirty if k in data}
+        dirty.clear()
+        return written
 
     __getitem__ = __getattr__
 

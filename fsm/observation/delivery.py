@@ -14,7 +14,11 @@ The thread wakes at the first event after a quiet spell, so an event of a machin
 and then reaches its observers at once (the page's latency); after a batch of at least
 ``BUSY_BATCH`` events it lets the machine run ``INTERVAL`` before taking the next, so that a
 machine stepping as fast as it can is delivered in a few batches per ``INTERVAL``, not in as many
-wake-ups as it has events. A root's termination is delivered in the machine's thread before its
+wake-ups as it has events. A machine that has ``INLINE_BATCH`` events waiting delivers them itself,
+in its own thread (``Reporter.send``): each batch the thread takes from a busy machine costs it two
+hand-overs of the GIL, and a busy machine never waits for them; the thread, told how many it
+delivered (``Reporter.inline``), sees it busy and comes back only after ``INTERVAL`` for what it
+left (docs/decisions/12-a-busy-machine-delivers-its-own-batches.md). A root's termination is delivered in the machine's thread before its
 ``execute`` returns (``Reporter.send``), so what ran is with every observer when the call that ran
 it ends, and so are the other events someone acts on at once (an error, a preempt, a control, a
 debugger's hold); ``Reporter.deliver`` does the same for an observer that closes (the recorder, the hub).
@@ -33,6 +37,7 @@ from .status import Status
 
 INTERVAL = 0.005  # s a busy machine runs between two batches (well within the log's 100 ms)
 BUSY_BATCH = 64  # a batch at least this large means the machine is busy: wait INTERVAL before the next
+INLINE_BATCH = 256  # events waiting: the machine's own thread delivers them (see the module's docstring)
 
 
 class Batch:
@@ -99,7 +104,8 @@ class _Delivery:
                 while ready:
                     reporter = ready.popleft()
                     try:
-                        largest = max(largest, reporter.deliver())
+                        largest = max(largest, reporter.deliver(), reporter.inline)
+                        reporter.inline = 0
                     except Exception:  # said once; the thread goes on for every other machine
                         reporter._failed(reporter.deliver, "delivering its events")
                 if largest >= BUSY_BATCH:

@@ -25,7 +25,7 @@ from typing import Any, Callable
 from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
 from . import names, schema
-from .delivery import Batch, BatchObserver, delivery
+from .delivery import INLINE_BATCH, Batch, BatchObserver, delivery
 from .encoding import encode_userdata
 from .schema import ABSENT, MAX_DOC, build
 from .status import Status
@@ -83,6 +83,7 @@ class Reporter:
         self._described_at = -1  # the construction generation of the last structure event
         self._told: list[Observer] = []  # the observers whose failure was printed
         self._status: Status | None = None  # folded in ``deliver`` once an observer asked for it
+        self.inline = 0  # events delivered in the machine's own thread since the delivery thread last looked
 
     @property
     def last_seq(self) -> int:
@@ -152,6 +153,7 @@ class Reporter:
                 return None
         elif self._pending is None:
             return None
+        waiting = 0
         lock = self._lock
         lock.acquire()  # not `with`: this is the hot path of every observed step
         try:
@@ -160,7 +162,8 @@ class Reporter:
             pending = self._pending
             if pending is not None:
                 pending.append(event)
-                if len(pending) == 1:
+                waiting = len(pending)
+                if waiting == 1:
                     delivery.ready(self)
             if observers:
                 self._owner = me
@@ -172,6 +175,9 @@ class Reporter:
                 self._owner = None
         finally:
             lock.release()
+        if waiting >= INLINE_BATCH:  # a busy machine: delivered here, with no hand-over of the GIL
+            self.inline += self.deliver()
+            return event
         kind = event["kind"]
         if kind in _AT_ONCE and (kind != "terminate" or path == self.root_path) and self._pending:
             self.deliver()

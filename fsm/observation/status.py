@@ -41,6 +41,31 @@ def _settle(entry: dict, last: dict | None) -> None:
     entry["last"] = last
 
 
+def _last_of_run(events: Sequence[dict], i: int, event: dict, entry: dict) -> tuple[dict, int]:
+    """``event``, a transition, and those of the same container that follow it at once in ``events``
+    (from ``i``), in the same run: a machine stepping fast. Each one's writes go into the userdata,
+    and only the last is left for the caller to settle the container with: what the others settled
+    is replaced by it (its changes' old values are read after theirs). Returns (the last, where the
+    events after it start)."""
+    path, run, n = event["path"], event.get("run"), len(events)
+    nxt = events[i]
+    if nxt["kind"] != "transition" or nxt["path"] != path or nxt.get("run") != run:
+        return event, i
+    userdata = entry["userdata"]
+    while True:
+        written = event.get("changes")
+        if written is not None:
+            userdata.update(written)
+        event, i = nxt, i + 1
+        if i == n:
+            break
+        nxt = events[i]
+        if nxt["kind"] != "transition" or nxt["path"] != path or nxt.get("run") != run:
+            break
+    entry["written"] = False  # as the transition before the last left it
+    return event, i
+
+
 class Status:
     """Per machine: structure, and per container path its active/initial states, userdata, outcome,
     last transition and the userdata keys that transition changed (old and new values); the robot's pose."""
@@ -68,30 +93,41 @@ class Status:
     def apply_all(self, events: Sequence[dict]) -> None:
         """Apply events in order: a batch of them (fsm/observation/delivery.py), in one loop whose
         every step of a running machine (a transition and the writes it carries, a userdata event)
-        is written out here."""
+        is written out here; the transitions of one container that follow each other are folded as
+        one (``_last_of_run``)."""
         containers = self.containers
         run = self.run
-        for event in events:
+        i, n = 0, len(events)
+        step = None  # the last event applied, when it is a step's: the seq and time the Status is at
+        while i < n:
+            event = events[i]
+            i += 1
             kind = event["kind"]
             path = event["path"]
-            seq = self.last_seq = event["seq"]
-            self.last_t = event.get("t")
             if event.get("run", run) != run:
                 run = self.run = event["run"]
-                self.run_seq = seq
+                self.run_seq = event["seq"]
             if kind == "transition" or kind == "userdata":
                 entry = containers.get(path)
                 if entry is None:
                     entry = containers[path] = _container_entry()
+                if kind == "transition" and i < n:
+                    event, i = _last_of_run(events, i, event, entry)
                 written = event.get("changes")  # a userdata event's, or those its step's transition carries
                 if written is not None:
                     _write(entry, written)
                 if kind == "transition":
                     entry["active"] = event["active"]  # events are never changed once emitted: no copy
-                    _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"], "seq": seq})
+                    _settle(entry, {"from": event["from"], "outcome": event["outcome"], "to": event["to"],
+                                    "seq": event["seq"]})
+                step = event
                 continue
+            step = None
+            self.last_seq, self.last_t = event["seq"], event.get("t")
             self._apply_other(event, kind, path)
             containers, run = self.containers, self.run  # a snapshot or a structure replaces them
+        if step is not None:
+            self.last_seq, self.last_t = step["seq"], step.get("t")
 
     def _apply_other(self, event: dict, kind: str, path: str) -> None:
         """Every kind but a step's: a run's start and end, the structure, a snapshot, a preempt, the

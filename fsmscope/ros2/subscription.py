@@ -153,7 +153,7 @@ class Subscription:
 
     def _refresh_publishers(self) -> None:
         self._reader.get_subscription_matched_status()  # resets the status the waitset woke on
-        matched = set(self._reader.get_matched_publications())
+        matched = _matched_publications(self._reader)
         for handle in matched - set(self._writers):
             data = self._reader.get_matched_publication_data(handle)
             if data is not None:
@@ -197,3 +197,14 @@ class Subscription:
                           f"but its writer does not match ours (its type's layout or its QoS differs): not received")
         for key in set(self._unmatched_since) - seen:
             del self._unmatched_since[key]
+
+
+def _matched_publications(reader: Any) -> set[int]:
+    """The instance handles of the writers ``reader`` matches. cyclonedds 11.0.1 counts them, then
+    lists them into an array of that count, and indexes past its end (IndexError) when a writer
+    matched in between: asked again, it counts that writer too."""
+    while True:
+        try:
+            return set(reader.get_matched_publications())
+        except IndexError:
+            continue

@@ -32,7 +32,7 @@ import threading
 import time
 from typing import Any, Protocol
 
-from .encoding import dumps
+from .encoding import dumps_all
 from .status import Status
 
 INTERVAL = 0.005  # s a busy machine runs between two batches (well within the log's 100 ms)
@@ -56,7 +56,7 @@ class Batch:
     def encoded(self) -> list[bytes]:
         data = self._encoded
         if data is None:
-            data = self._encoded = [dumps(event) for event in self.events]
+            data = self._encoded = dumps_all(self.events)
         return data
 
 

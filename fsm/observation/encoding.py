@@ -224,10 +224,20 @@ if orjson is not None:
         except TypeError:
             return _dumps(obj, option=_OPT)
 
+    def dumps_all(objs: Any, _dumps: Any = orjson.dumps) -> list[bytes]:
+        """``dumps`` of each object, in one call for a batch of events: orjson's loop, not Python's."""
+        try:
+            return list(map(_dumps, objs))
+        except TypeError:
+            return [dumps(obj) for obj in objs]
+
     loads = orjson.loads
 else:
     def dumps(obj: Any) -> bytes:
         return json.dumps(obj, separators=(",", ":"), ensure_ascii=False).encode()
+
+    def dumps_all(objs: Any) -> list[bytes]:
+        return list(map(dumps, objs))
 
     loads = json.loads
 

@@ -147,16 +147,15 @@ class Reporter:
         termination, an error, a preempt, a control, the debugger's holds) is delivered before this
         returns, with every event made before it."""
         observers = self._observers
-        if observers:
-            me = get_ident()
-            if self._owner == me:  # an observer logged: do not recurse into ourselves
+        if not observers:
+            if self._pending is None:
                 return None
-        elif self._pending is None:
+            return self._pend(make(0, 0.0, None, self.machine, path, *args))
+        me = get_ident()
+        if self._owner == me:  # an observer logged: do not recurse into ourselves
             return None
         waiting = 0
-        lock = self._lock
-        lock.acquire()  # not `with`: this is the hot path of every observed step
-        try:
+        with self._lock:
             self._seq = seq = self._seq + 1
             event = make(seq, _now(), self.run, self.machine, path, *args)
             pending = self._pending
@@ -165,23 +164,44 @@ class Reporter:
                 waiting = len(pending)
                 if waiting == 1:
                     delivery.ready(self)
-            if observers:
-                self._owner = me
-                for observer in observers:
-                    try:
-                        observer(event)
-                    except Exception:
-                        self._failed(observer)
-                self._owner = None
+            self._owner = me
+            for observer in observers:
+                try:
+                    observer(event)
+                except Exception:
+                    self._failed(observer)
+            self._owner = None
+        if waiting >= INLINE_BATCH or event["kind"] in _AT_ONCE:
+            self._deliver_now(event, waiting)
+        return event
+
+    def _pend(self, event: dict) -> dict:
+        """``send`` when only observers of batches listen, for an event made with its seq, time and run
+        to be stamped here: the hot path of every observed step (``transition`` comes straight here)."""
+        lock = self._lock
+        lock.acquire()  # not `with`: this is the hot path of every observed step
+        try:
+            self._seq = event["seq"] = self._seq + 1
+            event["t"] = _now()
+            event["run"] = self.run
+            pending = self._pending
+            pending.append(event)
+            waiting = len(pending)
+            if waiting == 1:
+                delivery.ready(self)
         finally:
             lock.release()
-        if waiting >= INLINE_BATCH:  # a busy machine: delivered here, with no hand-over of the GIL
-            self.inline += self.deliver()
-            return event
-        kind = event["kind"]
-        if kind in _AT_ONCE and (kind != "terminate" or path == self.root_path) and self._pending:
-            self.deliver()
+        if waiting >= INLINE_BATCH or event["kind"] in _AT_ONCE:
+            self._deliver_now(event, waiting)
         return event
+
+    def _deliver_now(self, event: dict, waiting: int) -> None:
+        """Deliver in this thread what a busy machine has waiting (``INLINE_BATCH``: with no hand-over
+        of the GIL to the delivery thread) and what someone acts on at once (``_AT_ONCE``)."""
+        if waiting >= INLINE_BATCH:
+            self.inline += self.deliver()
+        elif (event["kind"] != "terminate" or event["path"] == self.root_path) and self._pending:
+            self.deliver()
 
     def deliver(self) -> int:
         """Fold the events made so far and hand them to the observers that take batches, now, in this
@@ -233,7 +253,11 @@ class Reporter:
 
     def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str],
                    changes: dict | None = None) -> None:
-        self.send(_transition, path, from_, outcome, to, active, self._encoded(changes) if changes else ABSENT)
+        written = self._encoded(changes) if changes else ABSENT
+        if self._observers or self._pending is None:
+            self.send(_transition, path, from_, outcome, to, active, written)
+        else:
+            self._pend(_transition(0, 0.0, None, self.machine, path, from_, outcome, to, active, written))
 
     def terminate(self, path: str, last: list[str], outcome: str | None, active: list[str] = ABSENT,
                   state_outcome: str | None = ABSENT, outcomes: dict = ABSENT, error: str | None = ABSENT,

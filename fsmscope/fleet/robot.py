@@ -104,21 +104,21 @@ class _Machine:
         if self.name not in self.shared:
             with self.lock:
                 self.status.apply(event)
-        self.take((event["seq"], encoded(event)))
+        self.take(((event["seq"], encoded(event)),))
 
-    def take(self, item: tuple[int, bytes]) -> None:
-        """In the machine's thread: an event, (seq, its JSON), joins the pending batch, put at the
-        robot's next tick or when full (looked at every 16 events: a busy machine puts its own
+    def take(self, items: Sequence[tuple[int, bytes]]) -> None:
+        """In the thread that delivers the machine's events: events, (seq, their JSON), join the
+        pending batch, put at the robot's next tick or when full (a busy machine puts its own
         batches, the flusher those of a machine that waits for the tick). The fewest steps: this is
-        what publishing costs each step of a machine whose host encodes its events anyway
-        (ZenohRobot.follow)."""
+        what publishing costs a machine whose host encodes its events anyway (ZenohRobot.follow),
+        once per batch the host delivers."""
         pending = self.pending
-        pending.append(item)
-        n = len(pending)
-        if n == 1:
+        first = not pending
+        pending.extend(items)
+        if first:
             self.due = (monotonic() // LINGER + 1) * LINGER
             self.wake.set()
-        elif not n & 15 and (n >= MAX_BATCH or monotonic() >= self.due):
+        elif len(pending) >= MAX_BATCH or monotonic() >= self.due:
             self.flush()
 
     def flush(self, now: float | None = None) -> float | None:
@@ -133,14 +133,16 @@ class _Machine:
                 return None
             if now is not None and now < self.due:
                 return self.due
-            items = [pending.popleft() for _ in range(len(pending))]
-            payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
-            self.publisher.put(payload, attachment=batch_attachment(self.controls.token, self.key, self.origin, payload))
-            ring = self.ring
-            ring.append((items[0][0], items[-1][0], len(items), payload))
-            self.kept += len(items)
-            while self.kept - ring[0][2] >= RING:  # the oldest batches past RING events let go
-                self.kept -= ring.popleft()[2]
+            while pending:  # in puts of MAX_BATCH events at most: a host may hand over more at once
+                items = [pending.popleft() for _ in range(min(len(pending), MAX_BATCH))]
+                payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
+                self.publisher.put(payload, attachment=batch_attachment(self.controls.token, self.key, self.origin,
+                                                                        payload))
+                ring = self.ring
+                ring.append((items[0][0], items[-1][0], len(items), payload))
+                self.kept += len(items)
+                while self.kept - ring[0][2] >= RING:  # the oldest batches past RING events let go
+                    self.kept -= ring.popleft()[2]
             return None
 
     def _state(self, query: zenoh.Query) -> None:
@@ -259,13 +261,13 @@ class ZenohRobot:
         self.controls.handles[handle.reporter.machine] = handle
 
     def follow(self, machine: str, handle: MachineHandle, lock: Any,
-               current: Callable[[], Status]) -> Callable[[tuple[int, bytes]], None]:
+               current: Callable[[], Status]) -> Callable[[Sequence[tuple[int, bytes]]], None]:
         """Publish a machine its host observes anyway (the dashboard's hub, as ``run --zenoh`` and
         ``demo --zenoh`` compose them), instead of observing it too: the host gives the returned
-        callable each event as (seq, its JSON), in the thread that delivers it; controls are applied through
-        the host's ``handle``; state queries are answered from the host's ``Status`` (``current()``,
-        read holding ``lock``). The robot then keeps no Status and encodes nothing: publishing costs
-        the machine one call per event (bench/fleet_cost.py)."""
+        callable each batch of events as [(seq, its JSON), ...], in the thread that delivers it;
+        controls are applied through the host's ``handle``; state queries are answered from the
+        host's ``Status`` (``current()``, read holding ``lock``). The robot then keeps no Status and
+        encodes nothing: publishing costs the machine one call per batch (bench/fleet_cost.py)."""
         self.take_controls(handle)
         self._shared[machine] = (lock, current)
         self._declare(machine)

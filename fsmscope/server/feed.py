@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import asyncio
 import collections
+import operator
 import threading
 from typing import Any, Callable, Protocol, Sequence
 
@@ -36,8 +37,9 @@ HISTORY = schema.HISTORY_LIMIT  # events of the current run a new client is sent
 HANDOFF_LIMIT = 20000      # encoded events waiting for the loop, per machine, before they are dropped
 
 Item = tuple[int, bytes]  # an event as the ring keeps it: (seq, its JSON)
+_SEQ = operator.itemgetter("seq")
 EventSink = Callable[[Sequence[dict]], None]
-EncodedSink = Callable[[Item], None]
+EncodedSink = Callable[[Sequence[Item]], None]
 # Given the Status (holding the lock) before an event whose seq is at least the one it asked for, and
 # whether the feed starts over (a new Status): returns the seq of the next event it wants to see it before.
 StatusKeeper = Callable[[Status, bool], int]
@@ -91,7 +93,8 @@ class Feed:
         self._event_sinks = tuple(new if sink == old else sink for sink in self._event_sinks)
 
     def add_encoded_sink(self, sink: EncodedSink) -> None:
-        """``sink((seq, JSON))`` with every event from now on, in order: one that keeps or sends its bytes."""
+        """``sink([(seq, JSON), ...])`` with every batch of events from now on, in order: one that keeps or
+        sends their bytes (one call per batch, not per event: a busy machine pays for each call)."""
         self._encoded_sinks += (sink,)
 
     def keep_status(self, keeper: StatusKeeper) -> None:
@@ -112,12 +115,11 @@ class Feed:
         """A local machine's events, folded into the Status and encoded (once for every observer): give
         them to the sinks, let the keeper see the Status, hand them over; True when the loop must be told."""
         events = batch.events
-        items = list(zip([event["seq"] for event in events], batch.encoded()))
+        items = list(zip(map(_SEQ, events), batch.encoded()))
         for sink in self._event_sinks:
             sink(events)
         for sink in self._encoded_sinks:
-            for item in items:
-                sink(item)
+            sink(items)
         if self.status.last_seq + 1 >= self._next_kept:  # the Status is after the batch's last event
             self._next_kept = self._keeper(self.status, False)
         with self._handing:
@@ -163,7 +165,7 @@ class Feed:
             sink((event,))
         item = (seq, dumps(event))
         for sink in self._encoded_sinks:
-            sink(item)
+            sink((item,))
         self.ring.append(item)
         self.loop_seq = seq
         if self.idle:

@@ -242,7 +242,7 @@ def test_a_robot_following_its_host_publishes_the_hosts_encoded_events_and_answe
         def host_observer(event: dict) -> None:
             with lock:
                 host.apply(event)
-            take((event["seq"], dumps(event)))
+            take([(event["seq"], dumps(event))])
 
         reporter.add_observer(host_observer)
         dash = Delivered(connect=[endpoint])

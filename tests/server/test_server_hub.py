@@ -21,13 +21,13 @@ def has_terminate(got):
 
 def test_each_event_is_encoded_once_for_all_clients(live_server, monkeypatch):
     encoded = []
-    real = delivery.dumps
+    real = delivery.dumps_all
 
-    def counting(event):
-        encoded.append(event["seq"])
-        return real(event)
+    def counting(events):
+        encoded.extend(event["seq"] for event in events)
+        return real(events)
 
-    monkeypatch.setattr(delivery, "dumps", counting)
+    monkeypatch.setattr(delivery, "dumps_all", counting)
     sm = two_state_machine()
     entry = live_server.hub.add_local(sm, name="two")
     sockets = [stream(live_server, "two") for _ in range(3)]

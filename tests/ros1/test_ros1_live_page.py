@@ -49,6 +49,8 @@ def test_set_initial_state_and_preempt_from_the_page_start_the_robots_next_run_t
         runs = robot.output.count("outcome: ")
         page.click("#preempt-btn")
         page.click("#preempt-confirm")
+        page.wait_for_selector("#notice:has-text('Preempt accepted'), #notice:has-text('Preempt failed')")
+        assert "Preempt accepted" in page.text_content("#notice")
         wait_for(lambda: robot.output.count("outcome: ") > runs, 15, interval=0.1,
                  what=lambda: "the robot's run to end:\n" + robot.output[-2000:])
         assert robot.output.split("outcome: ")[runs + 1].startswith("stopped")

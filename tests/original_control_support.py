@@ -104,11 +104,6 @@ def holds(http, name="loop"):
     return debug["holds"] if debug is not None else []
 
 
-def controls(http, name, action=None):
-    events = http.get("/api/machines/%s/history" % name, params={"kinds": "control", "limit": 1000}).json()["events"]
-    return [e for e in events if action is None or e["action"] == action]
-
-
 @pytest.fixture
 def loop(live_server, smach):
     """The looping original machine served as 'loop', running in a thread; stopped and resumed at the end."""

@@ -11,9 +11,9 @@ from fsmscope.server.http_server import ServerThread
 from fsmscope.server.lease import Deadman
 from fsmscope.server.testing.polling import wait_for
 
-from original_control_support import (Bare, controls, holds, loop, run_in_thread, smach, status,  # noqa: F401
+from original_control_support import (Bare, holds, loop, run_in_thread, smach, status,  # noqa: F401
                                       visiting, waiter, waiting)
-from server_support import client, looping_machine
+from server_support import client, control_events as controls, looping_machine
 
 
 # Preempt, initial state, start.

@@ -9,7 +9,7 @@ from fsmscope.server.http_server import ServerThread
 from fsmscope.server.lease import Deadman
 from fsmscope.server.testing.polling import wait_for
 
-from server_support import client
+from server_support import client, control_events
 from server_support import looping_machine
 
 DEADMAN_AFTER = 1.5
@@ -58,8 +58,7 @@ def quick_deadman():
 
 
 def controls(srv, action=None):
-    events = client(srv).get("/api/machines/loop/history", params={"kinds": "control", "limit": 1000}).json()["events"]
-    return [e for e in events if action is None or e["action"] == action]
+    return control_events(client(srv), "loop", action)
 
 
 def test_a_pages_first_control_takes_the_free_lease(served):

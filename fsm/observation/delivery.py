@@ -1,8 +1,9 @@
 """Events handed to the observers that take them in batches, on one thread of the process.
 
 What a machine's thread does for an observed step is kept to what must be ordered there: the
-reporter stamps the event (seq, time, run), makes it and appends it to its pending list
-(fsm/observation/introspection.py). Everything else happens here, once per batch rather than once
+reporter appends a record of the step (its time, run and the values of its event) to its pending
+list, with no lock; the order of that list is the order of the seqs, which ``Reporter.deliver``
+stamps as it makes the events of a batch (fsm/observation/introspection.py). Everything else happens here, once per batch rather than once
 per event and once for every observer rather than once per observer: each event is encoded once
 (``Batch.encoded``, the same bytes for the log, the dashboard's ring and a robot's publisher), the
 machine's ``Status`` is folded once for every reader, and each observer takes the whole batch
@@ -102,7 +103,7 @@ class _Delivery:
             self._wake.clear()
             while True:
                 largest = 0
-                while ready:
+                for _ in range(len(ready)):  # those ready now: a machine that makes more meanwhile comes again
                     reporter = ready.popleft()
                     try:
                         largest = max(largest, reporter.deliver(), reporter.inline)

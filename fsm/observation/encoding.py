@@ -213,6 +213,19 @@ def encode_userdata(data: dict, cap: int | None = DEFAULT_CAP) -> dict:
     return out
 
 
+def encode_written(written: dict, cap: int = DEFAULT_CAP) -> dict:
+    """``encode_userdata`` of a dict made for the purpose (``UserData.take_written``'s, which nobody else
+    holds): itself when every key is a string and every value is already as it would be encoded (a
+    step's usual write: a count, a flag, a short text), without a copy; else the encoding."""
+    for key, value in written.items():
+        t = type(value)
+        if type(key) is not str or not (
+                t is int and -(2 ** 63) <= value < 2 ** 64 or t is str and len(value) <= cap or value is None
+                or t is bool or t is float and math.isfinite(value)):
+            return encode_userdata(written, cap)
+    return written
+
+
 if orjson is not None:
     _OPT = orjson.OPT_NON_STR_KEYS
 

@@ -2,7 +2,8 @@
 
 ``Reporter`` implements core's reporting seam (``fsm.core.reporting.Reporter``): core calls one
 method per kind with plain values, and the reporter encodes them, makes the event with the schema's
-maker of that kind (``schema.build``) and stamps it. A machine nobody observes pays one ``is None``
+maker of that kind (``schema.build``) and stamps it (a step's event is made and its seq stamped
+when it is delivered: ``Reporter.transition``, ``Reporter.deliver``). A machine nobody observes pays one ``is None``
 test per step: containers check their ``_reporter`` attribute, which stays None until ``attach``
 binds the tree.
 
@@ -26,7 +27,7 @@ from ..core import log, reporting
 from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (their public path)
 from . import names, schema
 from .delivery import INLINE_BATCH, Batch, BatchObserver, delivery
-from .encoding import encode_userdata
+from .encoding import encode_userdata, encode_written
 from .schema import ABSENT, MAX_DOC, build
 from .status import Status
 from .structure import children, is_container
@@ -76,8 +77,11 @@ class Reporter:
         self._seq = 0
         self._observers: list[Observer] = []  # called with each event, in ``send``
         self._batched: list[BatchObserver] = []  # given each batch, in ``deliver``
-        self._pending: list[dict] | None = None  # made, not delivered yet; None: nobody takes batches or folds
-        self._lock = threading.Lock()  # guards the seq and the pending list: held for each event made
+        # Made, not delivered yet, in order: events, and a step's record (``transition``) that ``deliver`` makes
+        # its event of; their seqs follow ``_seq`` in this order. None: nobody takes batches or folds.
+        self._pending: list[dict | tuple] | None = None
+        self._queued = False  # the delivery thread was told of the pending list since it last took it
+        self._lock = threading.Lock()  # guards the seq, and the pending list when plain observers listen or it is taken
         self._delivering = threading.RLock()  # one batch at a time; guards the Status
         self._owner: int | None = None  # the thread calling the plain observers right now
         self._described_at = -1  # the construction generation of the last structure event
@@ -87,7 +91,9 @@ class Reporter:
 
     @property
     def last_seq(self) -> int:
-        return self._seq
+        """The seq of the last event made (delivered or not)."""
+        pending = self._pending
+        return self._seq + (len(pending) if pending else 0)
 
     @property
     def listening(self) -> bool:
@@ -147,23 +153,26 @@ class Reporter:
         termination, an error, a preempt, a control, the debugger's holds) is delivered before this
         returns, with every event made before it."""
         observers = self._observers
+        pending = self._pending
         if not observers:
-            if self._pending is None:
+            if pending is None:
                 return None
-            return self._pend(make(0, 0.0, None, self.machine, path, *args))
+            return self._pend(make(0, _now(), self.run, self.machine, path, *args))
         me = get_ident()
         if self._owner == me:  # an observer logged: do not recurse into ourselves
             return None
         waiting = 0
         with self._lock:
-            self._seq = seq = self._seq + 1
+            if pending is None:
+                self._seq = seq = self._seq + 1
+            else:
+                seq = self._seq + len(pending) + 1
             event = make(seq, _now(), self.run, self.machine, path, *args)
-            pending = self._pending
             if pending is not None:
                 pending.append(event)
                 waiting = len(pending)
-                if waiting == 1:
-                    delivery.ready(self)
+                if not self._queued:
+                    self._queue()
             self._owner = me
             for observer in observers:
                 try:
@@ -176,24 +185,22 @@ class Reporter:
         return event
 
     def _pend(self, event: dict) -> dict:
-        """``send`` when only observers of batches listen, for an event made with its seq, time and run
-        to be stamped here: the hot path of every observed step (``transition`` comes straight here)."""
-        lock = self._lock
-        lock.acquire()  # not `with`: this is the hot path of every observed step
-        try:
-            self._seq = event["seq"] = self._seq + 1
-            event["t"] = _now()
-            event["run"] = self.run
-            pending = self._pending
-            pending.append(event)
-            waiting = len(pending)
-            if waiting == 1:
-                delivery.ready(self)
-        finally:
-            lock.release()
+        """``send`` when only observers of batches listen: the event, made with a placeholder seq, joins
+        the pending list with no lock (an append is one step under the GIL); ``deliver`` stamps its seq."""
+        pending = self._pending
+        pending.append(event)
+        if not self._queued:
+            self._queue()
+        waiting = len(pending)
         if waiting >= INLINE_BATCH or event["kind"] in _AT_ONCE:
             self._deliver_now(event, waiting)
         return event
+
+    def _queue(self) -> None:
+        """Tell the delivery thread of the pending list (``deliver`` clears the flag before it takes it, so
+        an event that misses a batch is told of again; told twice, the thread finds nothing the second time)."""
+        self._queued = True
+        delivery.ready(self)
 
     def _deliver_now(self, event: dict, waiting: int) -> None:
         """Deliver in this thread what a busy machine has waiting (``INLINE_BATCH``: with no hand-over
@@ -204,17 +211,24 @@ class Reporter:
             self.deliver()
 
     def deliver(self) -> int:
-        """Fold the events made so far and hand them to the observers that take batches, now, in this
-        thread; returns how many. The delivery thread calls it; so does a root's termination, and an
+        """Make the events of the steps recorded so far, stamp the seqs of all of them in the order they were
+        made, fold them and hand them to the observers that take batches, now, in this thread; returns how many. The delivery thread calls it; so does a root's termination, and an
         observer leaving or closing, so that it is given everything made before. A batch ends at the
         seq an observer wants the Status after (``next_cut``: the recorder's next snapshot)."""
         with self._delivering:
             with self._lock:
-                events = self._pending
-                if not events:
+                pending = self._pending
+                if not pending:
                     return 0
-                self._pending = []
-            start, first = 0, events[0]["seq"]  # the seqs of a reporter's pending events follow each other
+                self._queued = False  # before it is taken: what a machine's thread appends after is told again
+                taken = len(pending)
+                first = self._seq + 1
+                made = pending[:taken]
+                del pending[:taken]  # not replaced: a machine's thread may be appending to it without the lock
+                self._seq += taken
+            events = [_stamped(item, seq) if item.__class__ is dict else _transition(seq, *item)
+                      for seq, item in zip(range(first, first + taken), made)]
+            start = 0
             while start < len(events):
                 end = len(events)
                 for observer in self._batched:
@@ -254,10 +268,16 @@ class Reporter:
     def transition(self, path: str, from_: str, outcome: str, to: str | None, active: list[str],
                    changes: dict | None = None) -> None:
         written = self._encoded(changes) if changes else ABSENT
-        if self._observers or self._pending is None:
+        pending = self._pending
+        if self._observers or pending is None:
             self.send(_transition, path, from_, outcome, to, active, written)
-        else:
-            self._pend(_transition(0, 0.0, None, self.machine, path, from_, outcome, to, active, written))
+            return
+        # The hot path of every observed step: a record of ``_transition``'s arguments but the seq (``deliver``).
+        pending.append((_now(), self.run, self.machine, path, from_, outcome, to, active, written))
+        if not self._queued:
+            self._queue()
+        if len(pending) >= INLINE_BATCH:
+            self.inline += self.deliver()
 
     def terminate(self, path: str, last: list[str], outcome: str | None, active: list[str] = ABSENT,
                   state_outcome: str | None = ABSENT, outcomes: dict = ABSENT, error: str | None = ABSENT,
@@ -270,10 +290,11 @@ class Reporter:
         self.send(_userdata, path, encode_userdata(written))
 
     def _encoded(self, changes: dict) -> dict:
-        """The keys a step wrote, with their values, encoded (its event's ``changes``); what cannot be
-        encoded is said once and the event goes without them: a transition is never lost to its userdata."""
+        """The keys a step wrote, with their values (a dict of ``UserData.take_written``'s, nobody else's),
+        encoded (its event's ``changes``); what cannot be encoded is said once and the event goes without
+        them: a transition is never lost to its userdata."""
         try:
-            return encode_userdata(changes)
+            return encode_written(changes)
         except Exception:
             self._failed(encode_userdata, "observing (userdata)")  # a stable identity: said once
             return ABSENT
@@ -402,6 +423,11 @@ def reporter_of(machine: Any) -> Reporter | None:
     # (bench/debugger.py measured -30 % on the two-state loop).
     rep = getattr(machine, "_reporter", None)
     return rep if rep is not None and rep.root is machine else None
+
+
+def _stamped(event: dict, seq: int) -> dict:
+    event["seq"] = seq
+    return event
 
 
 def _on_log(level: str, msg: str) -> None:

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 from array import array
 from bisect import bisect_left, bisect_right
+from itertools import chain, compress, islice
+from operator import itemgetter, le, ne
 from typing import Sequence
 
 from fsm.logfiles.transcript import debug_message
@@ -33,6 +35,8 @@ MANY = "…"                # several states within one bucket
 _MARKS = frozenset(("start", "transition", "terminate"))
 _TICKS = frozenset(EVENT_TICK_KINDS)
 _DEBUG_TICKS = frozenset(("mode", "hold", "forced"))  # a release follows every hold: its tick would say nothing new
+_KIND, _PATH, _T, _SEQ, _ACTIVE, _FIRST = (itemgetter(key) for key in ("kind", "path", "t", "seq", "active", 0))
+_NO_LABEL = object()  # before a track's first mark: unequal to every label
 
 
 class _Track:
@@ -123,11 +127,13 @@ class TimelineIndex:
         if self.last is None:
             self.first = (events[0]["seq"], events[0]["t"])
         self.last = events[-1]
+        kinds = list(map(_KIND, events))
+        if len(kinds) > 1 and kinds.count("transition") == len(kinds) and self._add_steps(events):
+            return
         step_seqs, step_ts = self._steps
         tracks = self._tracks
         clock = self._clock
-        for event in events:
-            kind = event["kind"]
+        for event, kind in zip(events, kinds):
             if kind not in _MARKS:
                 if kind in _TICKS:
                     text = _tick_text(event, kind)
@@ -168,6 +174,34 @@ class TimelineIndex:
         self._clock = clock
         if len(step_seqs) > MAX_MARKS:
             self._coalesce()
+
+    def _add_steps(self, events: Sequence[dict]) -> bool:
+        """A batch of transitions of one container, each with one active state, at times that never go
+        back: a machine stepping fast, marked with C's loops rather than Python's (what ``add_all`` does
+        one event at a time, at a fifth of its cost). False, having done nothing, for any other batch."""
+        path = events[0]["path"]
+        paths = list(map(_PATH, events))
+        ts = list(map(_T, events))
+        actives = list(map(_ACTIVE, events))
+        if paths.count(path) != len(paths) or ts[0] < self._clock or not all(map(le, ts, islice(ts, 1, None))) \
+                or set(map(len, actives)) != {1}:
+            return False
+        seqs = list(map(_SEQ, events))
+        labels = list(map(_FIRST, actives))
+        step_seqs, step_ts = self._steps
+        step_seqs.extend(seqs)
+        step_ts.extend(ts)
+        track = self._tracks.get(path)
+        if track is None:
+            track = self._tracks[path] = _Track()
+        changed = list(map(ne, labels, chain((track.label[-1] if track.label else _NO_LABEL,), labels)))
+        track.t.extend(compress(ts, changed))
+        track.seq.extend(compress(seqs, changed))
+        track.label.extend(compress(labels, changed))
+        self._clock = ts[-1]
+        if len(step_seqs) > MAX_MARKS:
+            self._coalesce()
+        return True
 
     def _now(self, t: float) -> float:
         """``t``, or the latest time marked when the wall clock went back."""

@@ -8,7 +8,7 @@ import time
 
 import fsm
 import numpy as np
-from fsm.observation.encoding import DEFAULT_CAP, dumps, encode, encode_userdata, encoded
+from fsm.observation.encoding import DEFAULT_CAP, dumps, encode, encode_userdata, encode_written, encoded
 from hypothesis import given
 from hypothesis import strategies as st
 
@@ -184,3 +184,17 @@ def test_a_short_list_of_numbers_is_encoded_as_a_copy_the_machine_may_change_aft
 
 def test_a_short_list_with_an_infinite_number_still_says_it():
     assert encode((1.0, float("inf"), float("nan"))) == [1.0, "Infinity", "NaN"]
+
+
+written_values = st.one_of(st.integers(-(2 ** 70), 2 ** 70), st.floats(), st.booleans(), st.none(),
+                           st.text(max_size=3), st.just("x" * (DEFAULT_CAP + 1)), st.lists(st.integers(), max_size=2))
+
+
+@given(st.dictionaries(st.one_of(st.text(max_size=3), st.integers(0, 3)), written_values, max_size=3))
+def test_a_steps_writes_encode_as_any_userdata_does(written):
+    assert json.dumps(encode_written(dict(written)), sort_keys=True) == json.dumps(encode_userdata(written), sort_keys=True)
+
+
+def test_a_steps_plain_writes_are_their_own_encoding():
+    written = {"count": 3, "name": "pick", "ok": True, "ratio": 0.5, "none": None}
+    assert encode_written(written) is written

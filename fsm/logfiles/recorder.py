@@ -103,6 +103,7 @@ class Recorder:
         self._reporters: list[Any] = []  # the reporters of the machines attached: they deliver before closing
         self._snapshot_at: dict[str, int] = {}  # per machine: the seq at which to write the next snapshot
         self.lines = 0  # lines handed to the writer (events and snapshots)
+        self._waiting = 0  # lines in the buffer (counted as they come: counting the buffer's newlines costs per byte)
         self.snapshots = 0
         self.machines: list[str] = []
         self._closed = False
@@ -134,6 +135,7 @@ class Recorder:
             buf = self._buf
             buf += b"\n".join(data)
             buf += b"\n"
+            self._waiting += len(data)
             status = self._statuses.get(machine)
             if status is None:
                 status = self._new_machine(machine, events[0]["seq"])
@@ -159,6 +161,7 @@ class Recorder:
             buf = self._buf
             buf += data
             buf += b"\n"
+            self._waiting += 1
             machine = event["machine"]
             status = self._statuses.get(machine)
             if status is None:
@@ -174,7 +177,7 @@ class Recorder:
     @property
     def events(self) -> int:
         """Events recorded so far (snapshots not counted)."""
-        return self.lines + self._buf.count(b"\n") - self.snapshots
+        return self.lines + self._waiting - self.snapshots
 
     def _new_machine(self, machine: str, seq: int) -> Status:
         status = self._folded.pop(machine, None)
@@ -197,6 +200,7 @@ class Recorder:
         self._index_chunks.append(_dumps_line({"machine": status.machine, "seq": status.last_seq, "t": status.last_t,
                                                "offset": offset}))
         self._buf += _dumps_line(event)
+        self._waiting += 1
         self.snapshots += 1
 
     # Writing.
@@ -205,7 +209,8 @@ class Recorder:
             data, self._buf = self._buf, bytearray()
             index_chunks, self._index_chunks = self._index_chunks, []
             self._taken += len(data)
-            self.lines += data.count(b"\n")
+            self.lines += self._waiting
+            self._waiting = 0
             return data, b"".join(index_chunks)
 
     def flush(self) -> None:
@@ -230,7 +235,7 @@ class Recorder:
             if self.failure is not None:
                 return
             self.failure = exc
-            self._buf, self._index_chunks = bytearray(), []
+            self._buf, self._index_chunks, self._waiting = bytearray(), [], 0
         sys.stderr.write("fsm: recorder could not write %s: %s; the recording ends there\n"
                          % (self.path, exc.strerror or exc))
 

@@ -137,9 +137,11 @@ class TimelineIndex:
         kinds = list(map(_KIND, events))
         if len(kinds) > 1 and kinds.count("transition") == len(kinds) and self._add_steps(events):
             return
-        step_seqs, step_ts = self._steps
         tracks = self._tracks
         clock = self._clock
+        seqs: list[int] = []  # the marks' seqs and times, and each track's new marks: put in the arrays at the end
+        ts: list[float] = []
+        marks: dict[str, list] = {}  # path -> [times, seqs, labels, its track, the last label]
         for event, kind in zip(events, kinds):
             if kind not in _MARKS:
                 if kind in _TICKS:
@@ -162,23 +164,35 @@ class TimelineIndex:
                 t = clock
             else:
                 clock = t
-            track = tracks.get(event["path"])
-            if track is None:
-                track = tracks[event["path"]] = _Track()
+            path = event["path"]
+            new = marks.get(path)
+            if new is None:
+                track = tracks.get(path)
+                if track is None:
+                    track = tracks[path] = _Track()
+                new = marks[path] = [[], [], [], track, track.label[-1] if track.label else _NO_LABEL]
             if kind == "terminate":
                 label = None
             else:
                 active = event["active"]
                 label = active[0] if len(active) == 1 else (SEVERAL if active else None)
             seq = event["seq"]
-            step_seqs.append(seq)
-            step_ts.append(t)
-            labels = track.label
-            if not labels or labels[-1] != label:
-                track.t.append(t)
-                track.seq.append(seq)
-                labels.append(label)
+            seqs.append(seq)
+            ts.append(t)
+            if new[4] != label:
+                new[0].append(t)
+                new[1].append(seq)
+                new[2].append(label)
+                new[4] = label
         self._clock = clock
+        step_seqs, step_ts = self._steps
+        _extend(step_seqs, seqs)
+        _extend(step_ts, ts)
+        for times, marked, labels, track, _ in marks.values():
+            if labels:
+                _extend(track.t, times)
+                _extend(track.seq, marked)
+                track.label.extend(labels)
         if len(step_seqs) > MAX_MARKS:
             self._coalesce()
 

@@ -13,7 +13,9 @@ on average for the tick. A busy machine's thread puts its own batches (at the ti
 ``MAX_BATCH`` events), and no other thread touches its events: a hand-off of every event to a
 sender thread cost the two-state loop about three times as much, the GIL and the cache lines moving
 between the threads (bench/fleet_cost.py). A flusher thread puts the batches of the machines that
-wait for the tick. Puts drop rather than wait when the network is congested (Zenoh's
+wait for the tick; a machine that handed over events more than once in the tick is left a tick longer
+to put its batch itself (the flusher putting it took the GIL from the machine, and the machine's
+next batch then waited for the flusher's lock). Puts drop rather than wait when the network is congested (Zenoh's
 ``CongestionControl.DROP``), so a machine never waits for the network.
 
 Per machine it also declares, on the machine's first event:
@@ -83,6 +85,7 @@ class _Machine:
         # deque's append and popleft are atomic), whoever puts takes it holding ``putting``.
         self.pending: collections.deque[tuple[int, bytes]] = collections.deque()
         self.due = 0.0  # when the pending batch is put: the robot's next tick
+        self.busy = False  # the pending batch was given events more than once: its machine puts it itself
         self.putting = threading.Lock()  # one put at a time: batches go in order; guards the ring
         self.ring: collections.deque[tuple[int, int, int, bytes]] = collections.deque()  # (first, last, count, payload)
         self.kept = 0  # events in the ring
@@ -120,6 +123,8 @@ class _Machine:
             self.wake.set()
         elif len(pending) >= MAX_BATCH or monotonic() >= self.due:
             self.flush()
+        else:
+            self.busy = True
 
     def flush(self, now: float | None = None) -> float | None:
         """Put the pending batch if it is due at ``now`` (None: whatever its age). Returns when the
@@ -131,8 +136,12 @@ class _Machine:
                 return None
             if not pending:
                 return None
-            if now is not None and now < self.due:
-                return self.due
+            # A busy machine's batch is left to its own thread a tick longer: the flusher putting it would
+            # take the GIL from the machine, whose next batch would then wait for the flusher's lock.
+            due = self.due + LINGER if self.busy else self.due
+            if now is not None and now < due:
+                return due
+            self.busy = False
             while pending:  # in puts of MAX_BATCH events at most: a host may hand over more at once
                 items = [pending.popleft() for _ in range(min(len(pending), MAX_BATCH))]
                 payload = b",".join([data for seq, data in items]).join((b"[", b"]"))

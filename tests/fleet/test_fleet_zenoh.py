@@ -291,3 +291,20 @@ def test_a_machine_that_first_runs_after_its_robot_closed_runs_unpublished(quiet
     fsm.attach(sm, robot, name="loop")
     robot.close()
     assert sm.execute() == "done" and "loop" not in robot._machines
+
+
+def test_the_flusher_puts_a_quiet_machines_batch_at_the_tick_and_leaves_a_busy_ones_to_it_a_tick_longer(quiet):
+    robot = ZenohRobot("r1", listen=[free_endpoint()], token=TOKEN)
+    try:
+        robot._declare("m")
+        machine = robot._machines["m"]
+        machine.take([(1, b"{}")])  # one hand-over in the tick: a machine that waits for it
+        assert machine.flush(machine.due) is None and not machine.pending
+        machine.take([(2, b"{}")])
+        machine.due = time.monotonic() + 60  # the tick stays ahead while the test hands over again
+        machine.take([(3, b"{}")])  # a second hand-over in the same tick: a busy machine
+        due = machine.due
+        assert machine.flush(due) == due + fsmscope.fleet.robot.LINGER and len(machine.pending) == 2
+        assert machine.flush(due + fsmscope.fleet.robot.LINGER) is None and not machine.pending
+    finally:
+        robot.close()

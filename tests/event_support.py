@@ -54,3 +54,10 @@ def run_of(root: dict, machine: str = "m") -> list[dict]:
     events.append(ev(seq, "terminate", machine=machine, last=labels[-1:], state_outcome="go", outcome="done",
                      active=[]))
     return events
+
+
+def cut_into_batches(events: list[dict], cuts: list[int]) -> list[list[dict]]:
+    """``events`` cut at the given places (any integers: taken modulo one more than their number), in
+    order: a batched consumer's property tests compare these batches with the events one by one."""
+    places = sorted({c % (len(events) + 1) for c in cuts})
+    return [events[a:b] for a, b in zip([0] + places, places + [len(events)])]

@@ -2,6 +2,7 @@
 the timeline given them one by one (a batch of one container's transitions is marked with C's loops:
 ``TimelineIndex._add_steps``)."""
 
+from event_support import cut_into_batches
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -50,6 +51,4 @@ def indexed(batches: list[list[dict]]) -> tuple:
 @settings(max_examples=300, deadline=None)
 @given(streams(), st.lists(st.integers(0, 400), max_size=6))
 def test_a_timeline_given_batches_is_the_timeline_given_each_event_in_turn(events, cuts):
-    cuts = sorted({c % (len(events) + 1) for c in cuts})
-    batches = [events[a:b] for a, b in zip([0] + cuts, cuts + [len(events)])]
-    assert indexed(batches) == indexed([[event] for event in events])
+    assert indexed(cut_into_batches(events, cuts)) == indexed([[event] for event in events])

@@ -2,6 +2,7 @@
 batches, is the Status folded from them one by one (a batch's transitions of one container, one
 after the other, are folded as one: only the last settles the container)."""
 
+from event_support import cut_into_batches
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -51,6 +52,4 @@ def folded(batches: list[list[dict]]) -> dict:
 @settings(max_examples=300, deadline=None)
 @given(streams(), st.lists(st.integers(0, 200), max_size=6))
 def test_a_status_folded_in_batches_is_the_status_folded_event_by_event(events, cuts):
-    cuts = sorted({c % (len(events) + 1) for c in cuts})
-    batches = [events[a:b] for a, b in zip([0] + cuts, cuts + [len(events)])]
-    assert folded(batches) == folded([[event] for event in events])
+    assert folded(cut_into_batches(events, cuts)) == folded([[event] for event in events])

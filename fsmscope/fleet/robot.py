@@ -48,6 +48,8 @@ import secrets
 import sys
 import threading
 import time
+from itertools import chain
+from operator import itemgetter
 from time import monotonic
 from typing import Any, Callable, Sequence
 
@@ -68,6 +70,7 @@ MAX_BATCH = 512  # events per put at most (a payload of about 100 kB: larger one
                  # allocate, as fresh pages)
 LINGER = 0.005  # seconds between the robot's puts (a tick of its clock: fewer, larger puts, together; a
                 # dashboard following a fleet pays per message received, not per event)
+_DATA = itemgetter(1)  # an item's encoded event
 
 
 class _Machine:
@@ -81,9 +84,10 @@ class _Machine:
         self.shared = shared  # the robot's: a Status read instead of this one (a reporter's, a host's)
         self.wake = wake  # the flusher's
         self.lock = threading.Lock()  # guards the Status (the machine's thread and Zenoh's queries)
-        # The batch gathering, (seq, encoded event): the machine's thread appends without a lock (a
-        # deque's append and popleft are atomic), whoever puts takes it holding ``putting``.
-        self.pending: collections.deque[tuple[int, bytes]] = collections.deque()
+        # The batch gathering, as the host handed the events over ([(seq, encoded event), ...] each):
+        # the machine's thread appends without a lock (a deque's append and popleft are atomic), whoever
+        # puts takes it holding ``putting``.
+        self.pending: collections.deque[Sequence[tuple[int, bytes]]] = collections.deque()
         self.due = 0.0  # when the pending batch is put: the robot's next tick
         self.busy = False  # the pending batch was given events more than once: its machine puts it itself
         self.putting = threading.Lock()  # one put at a time: batches go in order; guards the ring
@@ -117,11 +121,11 @@ class _Machine:
         once per batch the host delivers."""
         pending = self.pending
         first = not pending
-        pending.extend(items)
+        pending.append(items)
         if first:
             self.due = (monotonic() // LINGER + 1) * LINGER
             self.wake.set()
-        elif len(pending) >= MAX_BATCH or monotonic() >= self.due:
+        elif sum(map(len, pending)) >= MAX_BATCH or monotonic() >= self.due:
             self.flush()
         else:
             self.busy = True
@@ -142,9 +146,10 @@ class _Machine:
             if now is not None and now < due:
                 return due
             self.busy = False
-            while pending:  # in puts of MAX_BATCH events at most: a host may hand over more at once
-                items = [pending.popleft() for _ in range(min(len(pending), MAX_BATCH))]
-                payload = b",".join([data for seq, data in items]).join((b"[", b"]"))
+            waiting = list(chain.from_iterable([pending.popleft() for _ in range(len(pending))]))
+            for start in range(0, len(waiting), MAX_BATCH):  # a host may hand over more at once
+                items = waiting[start:start + MAX_BATCH]
+                payload = b",".join(map(_DATA, items)).join((b"[", b"]"))
                 self.publisher.put(payload, attachment=batch_attachment(self.controls.token, self.key, self.origin,
                                                                         payload))
                 ring = self.ring
@@ -170,7 +175,7 @@ class _Machine:
             query.reply_err(b"since must be an integer")
             return
         with self.putting:
-            waiting = self.pending.copy()  # not put yet (a copy is atomic; the machine's thread appends)
+            waiting = list(chain.from_iterable(self.pending.copy()))  # not put yet (a copy is atomic)
             first = self.ring[0][0] if self.ring else waiting[0][0] if waiting else None
             parts = [payload[1:-1] for _, last, _, payload in self.ring if last >= since]
         parts += [data for seq, data in waiting if seq >= since]

@@ -28,7 +28,7 @@ from ..core.reporting import add_global_hook, remove_global_hook  # noqa: F401 (
 from . import names, schema
 from .delivery import INLINE_BATCH, Batch, BatchObserver, delivery
 from .encoding import encode_userdata, encode_written
-from .schema import ABSENT, MAX_DOC, build
+from .schema import ABSENT, MAX_DOC, build, build_batch
 from .status import Status
 from .structure import children, is_container
 
@@ -226,8 +226,7 @@ class Reporter:
                 made = pending[:taken]
                 del pending[:taken]  # not replaced: a machine's thread may be appending to it without the lock
                 self._seq += taken
-            events = [_stamped(item, seq) if item.__class__ is dict else _transition(seq, *item)
-                      for seq, item in zip(range(first, first + taken), made)]
+            events = build_batch(first, made)
             start = 0
             while start < len(events):
                 end = len(events)
@@ -423,11 +422,6 @@ def reporter_of(machine: Any) -> Reporter | None:
     # (bench/debugger.py measured -30 % on the two-state loop).
     rep = getattr(machine, "_reporter", None)
     return rep if rep is not None and rep.root is machine else None
-
-
-def _stamped(event: dict, seq: int) -> dict:
-    event["seq"] = seq
-    return event
 
 
 def _on_log(level: str, msg: str) -> None:

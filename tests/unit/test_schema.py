@@ -153,3 +153,14 @@ def test_the_reducers_status_holds_the_fields_of_the_schemas_status_and_no_other
               "breakpoint": (set(debug["breakpoints"][0]), _names(schema.BREAKPOINT_FIELDS))}
     assert {name: made for name, (made, defined) in shapes.items() if made != defined} == {}
     assert schema.STATUS.check(data) is None
+
+
+def test_a_batch_of_step_records_and_events_is_made_as_the_makers_make_each_stamped_in_order():
+    steps = [(1.0, "r1", "m", "/SM_ROOT", "A", "go", "B", ["B"], schema.ABSENT),
+             (2.0, "r1", "m", "/SM_ROOT", "B", "go", "A", ["A"], {"count": 2})]
+    start = schema.build.start(0, 0.5, "r1", "m", "/SM_ROOT", ["A"], ["A"], {})
+    made = schema.build_batch(7, [start, *steps])
+    expected = [schema.build.start(7, 0.5, "r1", "m", "/SM_ROOT", ["A"], ["A"], {}),
+                schema.build.transition(8, *steps[0]), schema.build.transition(9, *steps[1])]
+    assert [list(event.items()) for event in made] == [list(event.items()) for event in expected]
+    assert made[0] is start

@@ -7,7 +7,8 @@ One package, one module per concept:
 * ``status``: a machine's status (``fsm.observation.status.Status.to_dict()``), its debugger's state,
   holds and breakpoints;
 * ``events``: the envelope, each kind's fields, and ``build``, the one way each kind is made
-  (``fields_of``: a kind's own fields, without the envelope);
+  (``fields_of``: a kind's own fields, without the envelope; ``build_batch``: a batch's events, its
+  steps' records made into transitions by the same literal, stamped in order);
 * ``messages``: the websocket frames around the events (snapshot, events, missed, pace, ...), beside
   them as in viser's one message module;
 * ``tile``: the fleet overview's tile of a machine, and ``tile``, its maker;
@@ -24,7 +25,7 @@ fsmscope/server/models.py are tested against the status, breakpoint and tile sha
 Everything is importable from ``fsm.observation.schema`` itself. Standard library only, like the rest of ``fsm``.
 """
 
-from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, event, fields_of
+from .events import ENVELOPE, EVENT, KINDS, SOURCES, build, build_batch, event, fields_of
 from .fields import (ABSENT, BODY_POSE, BOOL, JSON, LIST_STR, MAP_BODY_POSE, MAP_NUMBER, MAP_OPT_STR, MAP_STR,
                      MAX_DOC, MAX_NAME, MAX_PATH, MAX_SEQ, MAX_STRUCTURE_DEPTH, MAX_STRUCTURE_NODES, MAX_VALUE_DEPTH,
                      NAME, NUMBER, OBJECT, OPT_NUMBER, OPT_STR, PATH, SEQ, SHAPES, STR, VERSION, Field, Kind, Type,

@@ -13,7 +13,8 @@ from __future__ import annotations
 from types import SimpleNamespace
 
 from .fields import (JSON, LIST_STR, MAP_OPT_STR, MAP_BODY_POSE, MAP_NUMBER, NAME, NUMBER, OBJECT, OPT_STR, PATH,
-                     SEQ, STR, VERSION, Field, Kind, Type, fields_problem, list_of, maker, nullable, one_of, simple)
+                     SEQ, STR, VERSION, Field, Kind, Type, batch_maker, fields_problem, list_of, maker, nullable, one_of,
+                     simple)
 from .status import AT, BREAKPOINT, DEBUG_ACTIONS, DEBUG_MODES, STATUS
 from .tree import NODE
 
@@ -110,6 +111,10 @@ def _envelope(kind: str) -> tuple[tuple[str, str], ...]:
 
 # ``build.KIND(...)``: the one way an event of each kind is made.
 build = SimpleNamespace(**{name: maker(name, _envelope(name), k.fields, k.doc) for name, k in KINDS.items()})
+
+# ``build_batch(first_seq, items)``: a batch's events stamped in order, its steps' records made into
+# transitions (fields.batch_maker; the reporter's records: fsm/observation/introspection.py).
+build_batch = batch_maker("build_batch", _envelope("transition"), KINDS["transition"].fields)
 
 # ``fields_of.KIND(...)``: a kind's own fields without the envelope, for what handles them before any
 # reporter stamps them (the simulator's pose sampler, POST /api/scene/pose): made as ``build`` makes events.

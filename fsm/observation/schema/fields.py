@@ -239,3 +239,33 @@ def maker(name: str, head: tuple[tuple[str, str], ...], fields: tuple[Field, ...
     made = scope[name]
     made.__doc__ = doc
     return made
+
+
+def batch_maker(name: str, head: tuple[tuple[str, str], ...], fields: tuple[Field, ...]) -> Callable[..., list]:
+    """``made(first_seq, items)``: the events of a batch, in order, the i-th stamped with seq
+    ``first_seq + i``. An item is either an event made already (its seq is stamped) or a tuple of
+    ``maker``'s arguments after the seq (a record of a step: fsm/observation/introspection.py), made
+    into its event by the same dict literal ``maker`` would build, in one comprehension: no call per
+    event. ``head`` must start with the version and the seq; at most one optional field."""
+    optional = [f.name for f in fields if not f.required]
+    assert [key for key, _ in head[:2]] == ["v", "seq"] and len(optional) <= 1
+    params = [expr for key, expr in head if expr == key and key != "seq"] + [argument(f.name) for f in fields]
+    where = {param: "item[%d]" % i for i, param in enumerate(params)}
+    where["seq"] = "seq"
+    items = ["%r: %s" % (key, where.get(expr, expr)) for key, expr in head]
+    items += ["%r: %s" % (f.name, where[argument(f.name)]) for f in fields if f.required]
+    literal = "{%s}" % ", ".join(items)
+    if optional:
+        last = where[argument(optional[0])]
+        literal = "(%s if %s is ABSENT else {%s, %r: %s})" % (literal, last, ", ".join(items), optional[0], last)
+    lines = ["def %s(first, items):" % name,
+             "    return [_stamped(item, seq) if item.__class__ is dict else %s" % literal,
+             "            for seq, item in zip(range(first, first + len(items)), items)]"]
+    scope: dict = {"ABSENT": ABSENT, "_stamped": _stamped}
+    exec("\n".join(lines), scope)
+    return scope[name]
+
+
+def _stamped(event: dict, seq: int) -> dict:
+    event["seq"] = seq
+    return event

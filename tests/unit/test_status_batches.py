@@ -17,7 +17,8 @@ values = st.dictionaries(st.sampled_from(("count", "pose", "name")), st.integers
 @st.composite
 def streams(draw) -> list[dict]:
     """Two runs' worth of a machine's events: starts, runs of transitions (with and without the writes
-    they carry) in the root and a child container, userdata events between them, terminations."""
+    they carry, up to 21 of one container in a row) in the root and a child container, userdata events
+    between them, terminations."""
     events: list[dict] = []
 
     def add(make, path, *args, **optional):
@@ -25,12 +26,13 @@ def streams(draw) -> list[dict]:
 
     for run in draw(st.lists(st.sampled_from(("r1", "r2")), min_size=1, max_size=2)):
         add(build.start, ROOT, ["A"], ["A"], draw(values))
-        for kind, path, frm, to, changes in draw(st.lists(st.tuples(
+        for kind, path, frm, to, changes, steps in draw(st.lists(st.tuples(
                 st.sampled_from(("transition", "transition", "transition", "userdata", "start", "terminate")),
-                st.sampled_from((ROOT, SUB)), st.sampled_from(STATES), st.sampled_from(STATES), values),
-                min_size=4, max_size=40)):
-            if kind == "transition":
-                add(build.transition, path, frm, "next", to, [to], **({"changes": changes} if changes else {}))
+                st.sampled_from((ROOT, SUB)), st.sampled_from(STATES), st.sampled_from(STATES), values,
+                st.lists(values, max_size=20)), min_size=4, max_size=40)):
+            if kind == "transition":  # and a run of the container's transitions after it, each with its writes
+                for written in [changes] + steps:
+                    add(build.transition, path, frm, "next", to, [to], **({"changes": written} if written else {}))
             elif kind == "userdata" and changes:
                 add(build.userdata, path, changes)
             elif kind == "start":

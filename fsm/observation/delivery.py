@@ -3,13 +3,14 @@
 What a machine's thread does for an observed step is kept to what must be ordered there: the
 reporter appends a record of the step (its time, run and the values of its event) to its pending
 list, with no lock; the order of that list is the order of the seqs, which ``Reporter.deliver``
-stamps as it makes the events of a batch (fsm/observation/introspection.py). Everything else happens here, once per batch rather than once
-per event and once for every observer rather than once per observer: each event is encoded once
-(``Batch.encoded``, the same bytes for the log, the dashboard's ring and a robot's publisher), the
-machine's ``Status`` is folded once for every reader, and each observer takes the whole batch
-(the recorder appends it to its buffer, the hub's feed to its hand-off to the loop). Under the
-GIL, moving work to another thread does not make it cheaper (decision 05); what batches save is
-the per-event work of every hop: a lock, a call, a wake-up, a check, a Python loop iteration.
+stamps as it makes the events of a batch (fsm/observation/introspection.py). Everything else happens
+here, once per batch rather than once per event and once for every observer rather than once per
+observer: each event is encoded once (``Batch.encoded``, the same bytes for the log, the dashboard's
+ring and a robot's publisher), the machine's ``Status`` is folded once for every reader, and each
+observer takes the whole batch (the recorder appends it to its buffer, the hub's feed to its
+hand-off to the loop). Under the GIL, moving work to another thread does not make it cheaper
+(decision 05); what batches save is the per-event work of every hop: a lock, a call, a wake-up, a
+check, a Python loop iteration.
 
 The thread wakes at the first event after a quiet spell, so an event of a machine that steps now
 and then reaches its observers at once (the page's latency); after a batch of at least

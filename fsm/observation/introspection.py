@@ -2,10 +2,10 @@
 
 ``Reporter`` implements core's reporting seam (``fsm.core.reporting.Reporter``): core calls one
 method per kind with plain values, and the reporter encodes them, makes the event with the schema's
-maker of that kind (``schema.build``) and stamps it (a step's event is made and its seq stamped
-when it is delivered: ``Reporter.transition``, ``Reporter.deliver``). A machine nobody observes pays one ``is None``
-test per step: containers check their ``_reporter`` attribute, which stays None until ``attach``
-binds the tree.
+maker of that kind (``schema.build``) and stamps it (a step's event is made and its seq stamped when
+it is delivered: ``Reporter.transition``, ``Reporter.deliver``). A machine nobody observes pays one
+``is None`` test per step: containers check their ``_reporter`` attribute, which stays None until
+``attach`` binds the tree.
 
 One piece because stamping, delivering and folding an event, and describing the tree the events
 refer to, share one reporter's lock, sequence and run.
@@ -211,8 +211,9 @@ class Reporter:
             self.deliver()
 
     def deliver(self) -> int:
-        """Make the events of the steps recorded so far, stamp the seqs of all of them in the order they were
-        made, fold them and hand them to the observers that take batches, now, in this thread; returns how many. The delivery thread calls it; so does a root's termination, and an
+        """Make the events of the steps recorded so far, stamp the seqs of all of them in the order they
+        were made, fold them and hand them to the observers that take batches, now, in this thread;
+        returns how many. The delivery thread calls it; so does a root's termination, and an
         observer leaving or closing, so that it is given everything made before. A batch ends at the
         seq an observer wants the Status after (``next_cut``: the recorder's next snapshot)."""
         with self._delivering:

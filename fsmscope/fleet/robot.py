@@ -15,7 +15,8 @@ sender thread cost the two-state loop about three times as much, the GIL and the
 between the threads (bench/fleet_cost.py). A flusher thread puts the batches of the machines that
 wait for the tick; a machine that handed over events more than once in the tick is left a tick longer
 to put its batch itself (the flusher putting it took the GIL from the machine, and the machine's
-next batch then waited for the flusher's lock). Puts drop rather than wait when the network is congested (Zenoh's
+next batch then waited for the flusher's lock). Puts drop rather than wait when the network is
+congested (Zenoh's
 ``CongestionControl.DROP``), so a machine never waits for the network.
 
 Per machine it also declares, on the machine's first event:

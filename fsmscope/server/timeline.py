@@ -199,7 +199,7 @@ class TimelineIndex:
     def _add_steps(self, events: Sequence[dict]) -> bool:
         """A batch of transitions of one container, each with one active state, at times that never go
         back: a machine stepping fast, marked with C's loops rather than Python's (what ``add_all`` does
-        one event at a time, at a fifth of its cost). False, having done nothing, for any other batch."""
+        one event at a time, at about half its cost). False, having done nothing, for any other batch."""
         path = events[0]["path"]
         paths = list(map(_PATH, events))
         ts = list(map(_T, events))

@@ -12,19 +12,19 @@ hand-off to the loop). Under the GIL, moving work to another thread does not mak
 (decision 05); what batches save is the per-event work of every hop: a lock, a call, a wake-up, a
 check, a Python loop iteration.
 
-The thread wakes at the first event after a quiet spell, so an event of a machine that steps now
-and then reaches its observers at once (the page's latency); after a batch of at least
-``BUSY_BATCH`` events it lets the machine run ``INTERVAL`` before taking the next, so that a
-machine stepping as fast as it can is delivered in a few batches per ``INTERVAL``, not in as many
-wake-ups as it has events. A machine that has ``INLINE_BATCH`` events waiting delivers them itself,
-in its own thread (``Reporter._pend``): each batch the thread takes from a busy machine costs it two
-hand-overs of the GIL, and a busy machine never waits for them; the thread, told how many it
+The thread wakes at the first event after a quiet spell, so an event of a machine that steps now and
+then reaches its observers at once (the page's latency); after a batch of at least ``BUSY_BATCH``
+events it lets the machine run ``INTERVAL`` before taking the next, so that a machine stepping as
+fast as it can is delivered in a few batches per ``INTERVAL``, not in as many wake-ups as it has
+events. A machine that has ``INLINE_BATCH`` events waiting delivers them itself, in its own thread
+(``Reporter.transition``, ``Reporter._pend``): each batch the thread takes from a busy machine costs
+it two hand-overs of the GIL, and a busy machine never waits for them; the thread, told how many it
 delivered (``Reporter.inline``), sees it busy and comes back only after ``INTERVAL`` for what it
 left (docs/decisions/12-a-busy-machine-delivers-its-own-batches.md). A root's termination is
-delivered in the machine's thread before its ``execute`` returns (``Reporter.send``), so what ran
-is with every observer when the call that ran it ends, and so are the other events someone acts on
-at once (an error, a preempt, a control, a debugger's hold); ``Reporter.deliver`` does the same for
-an observer that closes (the recorder, the hub).
+delivered in the machine's thread before its ``execute`` returns (``Reporter.send``), so what ran is
+with every observer when the call that ran it ends, and so are the other events someone acts on at
+once (an error, a preempt, a control, a debugger's hold); ``Reporter.deliver`` does the same for an
+observer that closes (the recorder, the hub).
 """
 
 from __future__ import annotations

@@ -244,6 +244,11 @@ class RosWatcher:
                     self._deliver(events)
                 self._seen(machine.name, False)
 
+    def _publishing(self, server: str, publisher: str) -> bool:
+        """Whether ``publisher`` is connected on ``server``'s status topic now."""
+        subscription = self._subscriptions.get(server + STATUS_SUFFIX)
+        return subscription is not None and publisher in subscription.publishers
+
     # The following thread: messages to the followers, in stamp order, once they waited.
     def _follow(self) -> None:
         waiting = self._waiting
@@ -286,8 +291,8 @@ class RosWatcher:
                                                    self._stop_topic(name))
             threading.Thread(target=self._advertise_controls, args=(machine,), name="fsmscope-ros-advertise",
                              daemon=True).start()
-        elif not machine.up:
-            machine.up = True
+        elif not machine.up and self._publishing(server, received.publisher):
+            machine.up = True  # not by a message that waited for its window after its publisher went away
             self._seen(machine.name, True)
         self._give(machine, Message(stamp, server, kind, fields, received.publisher))
 
